@@ -1,0 +1,152 @@
+//! One-dimensional Ritz functions on ξ ∈ [0, 1] and their integrals (MODEL.md §3.1, "Two bases").
+//!
+//! A component of length L uses x = Lξ; derivatives here are with respect to ξ and the
+//! assembly divides by the powers of L.
+
+pub mod characteristic;
+pub mod legendre;
+pub mod quadrature;
+
+pub use characteristic::{BeamFunctions, End, RodFunctions};
+pub use legendre::{LegendreBending, LegendreFree, LegendreRod};
+pub use quadrature::Quadrature;
+
+use faer::Mat;
+use serde::{Deserialize, Serialize};
+
+/// X(ξ) and its first three ξ-derivatives.
+pub type Derivs = [f64; 4];
+
+/// Which family of Ritz functions to expand the deformations in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BasisKind {
+    /// Integrated Legendre polynomials satisfying the clamped root conditions (default).
+    #[default]
+    Legendre,
+    /// The paper's beam characteristic functions (1.6)–(1.7).
+    Characteristic,
+}
+
+impl BasisKind {
+    /// Lower-case name as in the scenario file.
+    pub fn name(self) -> &'static str {
+        match self {
+            BasisKind::Legendre => "legendre",
+            BasisKind::Characteristic => "characteristic",
+        }
+    }
+
+    /// Bending functions of a beam clamped at ξ = 0 and free at ξ = 1.
+    pub fn bending(self, n: usize) -> Box<dyn Basis1d> {
+        match self {
+            BasisKind::Legendre => Box::new(LegendreBending::new(n)),
+            BasisKind::Characteristic => Box::new(BeamFunctions::new(End::Clamped, End::Free, n)),
+        }
+    }
+
+    /// Axial or torsion functions of a rod clamped at ξ = 0.
+    pub fn rod(self, n: usize) -> Box<dyn Basis1d> {
+        match self {
+            BasisKind::Legendre => Box::new(LegendreRod::new(n)),
+            BasisKind::Characteristic => Box::new(RodFunctions::clamped_free(n)),
+        }
+    }
+
+    /// Free–free functions (across a plate's width), rigid pair included.
+    pub fn free_free(self, n: usize) -> Box<dyn Basis1d> {
+        match self {
+            BasisKind::Legendre => Box::new(LegendreFree::new(n)),
+            BasisKind::Characteristic => Box::new(BeamFunctions::new(End::Free, End::Free, n)),
+        }
+    }
+}
+
+/// A finite family of functions on [0, 1].
+pub trait Basis1d: std::fmt::Debug + Send + Sync {
+    /// Number of functions.
+    fn len(&self) -> usize;
+
+    /// True for an empty family.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every function's value and first three ξ-derivatives at ξ, into `out[..len]`.
+    fn eval_all(&self, xi: f64, out: &mut [Derivs]);
+
+    /// Highest polynomial degree, for polynomial families (selects an exact Gauss rule).
+    fn polynomial_degree(&self) -> Option<usize> {
+        None
+    }
+
+    /// Largest wavenumber (β or (2n−1)π/2) of a trigonometric family.
+    fn max_wavenumber(&self) -> f64 {
+        1.0
+    }
+
+    /// Every function at ξ, as a vector.
+    fn eval_vec(&self, xi: f64) -> Vec<Derivs> {
+        let mut out = vec![[0.0; 4]; self.len()];
+        self.eval_all(xi, &mut out);
+        out
+    }
+
+    /// A quadrature rule that integrates products of two functions (and their derivatives)
+    /// to rounding: exact Gauss for polynomials; for trigonometric–hyperbolic families, a
+    /// composite rule with ≥ 2 twelve-point panels per period of the fastest product.
+    fn quadrature(&self) -> Quadrature {
+        match self.polynomial_degree() {
+            Some(d) => Quadrature::gauss(d + 2),
+            None => Quadrature::composite(((self.max_wavenumber() / 3.0).ceil() as usize).max(4), 12),
+        }
+    }
+}
+
+/// The integrals over ξ ∈ [0, 1] that the Ritz assembly needs, for one family φ_i.
+#[derive(Debug, Clone)]
+pub struct Integrals {
+    /// ∫ φ_i φ_j dξ.
+    pub i00: Mat<f64>,
+    /// ∫ φ_i' φ_j' dξ.
+    pub i11: Mat<f64>,
+    /// ∫ φ_i'' φ_j'' dξ.
+    pub i22: Mat<f64>,
+    /// ∫ φ_i'' φ_j dξ.
+    pub i20: Mat<f64>,
+    /// ∫ φ_i dξ.
+    pub m0: Vec<f64>,
+    /// ∫ ξ φ_i dξ.
+    pub m1: Vec<f64>,
+}
+
+impl Integrals {
+    /// Computes every integral with the family's own quadrature rule.
+    pub fn new(basis: &dyn Basis1d) -> Self {
+        let n = basis.len();
+        let q = basis.quadrature();
+        let mut i00 = Mat::zeros(n, n);
+        let mut i11 = Mat::zeros(n, n);
+        let mut i22 = Mat::zeros(n, n);
+        let mut i20 = Mat::zeros(n, n);
+        let mut m0 = vec![0.0; n];
+        let mut m1 = vec![0.0; n];
+        let mut vals = vec![[0.0; 4]; n];
+        for (&x, &w) in q.points.iter().zip(&q.weights) {
+            basis.eval_all(x, &mut vals);
+            for i in 0..n {
+                let vi = vals[i];
+                m0[i] += w * vi[0];
+                m1[i] += w * x * vi[0];
+                for j in 0..n {
+                    let vj = vals[j];
+                    i00[(i, j)] += w * vi[0] * vj[0];
+                    i11[(i, j)] += w * vi[1] * vj[1];
+                    i22[(i, j)] += w * vi[2] * vj[2];
+                    i20[(i, j)] += w * vi[2] * vj[0];
+                }
+            }
+        }
+        Self { i00, i11, i22, i20, m0, m1 }
+    }
+}

@@ -1,0 +1,24 @@
+//! # flexcraft
+//!
+//! Dynamics of flexible spacecraft with deployable solar arrays (see `MODEL.md` of the
+//! project and the paper by Borisov & Avramenko). The library computes, from a
+//! [`scenario::Scenario`], the natural modes of the deployed spacecraft by Rayleigh–Ritz
+//! synthesis ([`ritz`]) over one of two bases ([`basis`]).
+//!
+//! Data flows one way: scenario file → [`structure::Structure`] → [`ritz::RitzModel`] →
+//! [`ritz::ModalAnalysis`] → outputs. The library never prints and never exits; the
+//! `flexcraft` binary is a thin command-line layer over it.
+//!
+//! SI units throughout: m, kg, s, N, Pa, rad.
+#![warn(missing_docs)]
+
+pub mod basis;
+pub mod math;
+pub mod output;
+pub mod ritz;
+pub mod scenario;
+pub mod structure;
+
+pub use ritz::{ModalAnalysis, RitzModel};
+pub use scenario::Scenario;
+pub use structure::Structure;

@@ -1,0 +1,84 @@
+//! `flexcraft`: the command-line layer over the library. It reads files, prints, picks exit
+//! codes; the physics lives in the library.
+
+use clap::{Parser, Subcommand};
+use flexcraft::output::{self, OutputDir};
+use flexcraft::{ModalAnalysis, RitzModel, Scenario};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+const UNITS: &str = "Units: SI throughout — lengths m, masses kg, inertias kg·m², moduli Pa, \
+frequencies Hz (and rad/s), angles rad.";
+
+#[derive(Parser)]
+#[command(name = "flexcraft", version, about = "Dynamics of flexible spacecraft with deployable solar arrays.", after_help = UNITS)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Natural frequencies and mode shapes of the deployed spacecraft (Rayleigh–Ritz).
+    #[command(after_help = UNITS)]
+    Modes {
+        /// Scenario file (TOML, format version 1; see docs/scenario.md).
+        scenario: PathBuf,
+        /// Print one JSON object on stdout instead of the table.
+        #[arg(long)]
+        json: bool,
+        /// Also write modes.json, frequencies.csv, coefficient and shape CSVs and plots here.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Modes { scenario, json, out } => run_modes(&scenario, json, out.as_deref()),
+    }
+}
+
+/// Exit status 2: the input was refused. 1: an output could not be written or a numerical
+/// failure.
+fn run_modes(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
+    let scenario = match Scenario::from_file(path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let model = RitzModel::assemble(&scenario.structure);
+    let modes = match ModalAnalysis::compute(&model) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    };
+    if json {
+        println!("{}", output::modes_json(&model, &modes));
+    } else {
+        print!("{}", output::modes_table(&scenario, &model, &modes));
+    }
+    if let Some(dir) = out {
+        let written = OutputDir::create(dir).and_then(|mut d| {
+            output::write_modes(&mut d, &model, &modes)?;
+            d.commit()
+        });
+        match written {
+            Ok(files) => {
+                if !json {
+                    println!("wrote {} files to {}", files, dir.display());
+                }
+            }
+            Err(e) => {
+                eprintln!("error: writing {}: {e}", dir.display());
+                return ExitCode::from(1);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,36 @@
+//! Outputs: the terminal table, JSON, CSV files and plots. Everything is deterministic (no
+//! time stamps; shortest round-trip float formatting) and written through [`OutputDir`].
+
+mod atomic;
+mod modes;
+pub mod plot;
+
+pub use atomic::OutputDir;
+pub use modes::{modes_json, modes_table, write_modes};
+
+use thiserror::Error;
+
+/// Failure to write an output.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    /// File-system error.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// The plotting back end failed.
+    #[error("plot {file}: {reason}")]
+    Plot {
+        /// The plot file.
+        file: String,
+        /// What went wrong.
+        reason: String,
+    },
+}
+
+impl From<OutputError> for std::io::Error {
+    fn from(e: OutputError) -> Self {
+        match e {
+            OutputError::Io(e) => e,
+            other => std::io::Error::other(other.to_string()),
+        }
+    }
+}

@@ -1,0 +1,268 @@
+//! Modal-analysis outputs: table, JSON, CSV, mode-shape samples and pictures.
+
+use super::{plot, OutputDir, OutputError};
+use crate::ritz::shapes::{sample_beam, sample_plate, PointSample};
+use crate::ritz::{ElementBasis, ModalAnalysis, Mode, RitzModel};
+use crate::scenario::Scenario;
+use crate::structure::{ComponentId, HubMotion};
+use serde_json::{json, Map, Value};
+use std::fmt::Write;
+
+const DIRECTIONS: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+fn shares_json(m: &Mode) -> Value {
+    let mut map = Map::new();
+    for (n, s) in &m.strain_energy_share {
+        map.insert(n.clone(), json!(s));
+    }
+    Value::Object(map)
+}
+
+/// The modes as one JSON object (the `--json` interface and `modes.json`).
+pub fn modes_json(model: &RitzModel, modes: &ModalAnalysis) -> String {
+    let st = &model.structure;
+    let list: Vec<Value> = modes
+        .modes
+        .iter()
+        .map(|m| {
+            json!({
+                "number": m.number,
+                "rigid": m.rigid,
+                "frequency_hz": m.frequency_hz(),
+                "omega_rad_s": m.omega_rad_s,
+                "dominant": m.dominant(),
+                "strain_energy_share": shares_json(m),
+                "effective_mass_kg": m.effective_mass,
+            })
+        })
+        .collect();
+    let fractions = modes.effective_mass_fractions();
+    let fixed: Vec<Value> = modes
+        .hub_fixed
+        .iter()
+        .zip(&fractions)
+        .enumerate()
+        .map(|(i, (m, f))| {
+            json!({
+                "number": i + 1,
+                "frequency_hz": m.omega_rad_s / (2.0 * std::f64::consts::PI),
+                "omega_rad_s": m.omega_rad_s,
+                "effective_mass_kg": m.effective_mass,
+                "cumulative_fraction": f,
+            })
+        })
+        .collect();
+    let v = json!({
+        "units": {
+            "frequency_hz": "Hz", "omega_rad_s": "rad/s",
+            "effective_mass_kg": "kg for x, y, z; kg·m² for rx, ry, rz (about the hub's centre of mass, structure axes)",
+            "shapes": "mass-normalised: modal coordinate × shape = displacement in m",
+        },
+        "name": st.name,
+        "basis": st.basis.name(),
+        "hub_motion": match st.hub.motion { HubMotion::Free => "free", HubMotion::Fixed => "fixed" },
+        "dof": modes.dof,
+        "total_mass_kg": st.total_mass(),
+        "modes": list,
+        "hub_fixed": {
+            "directions": DIRECTIONS,
+            "appendage_mass_kg": modes.appendage_mass,
+            "effective_mass_fraction": fractions.last().copied().unwrap_or([0.0; 6]),
+            "modes": fixed,
+        },
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// The terminal table.
+pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis) -> String {
+    let st = &scenario.structure;
+    let mut s = String::new();
+    let motion = match st.hub.motion {
+        HubMotion::Free => "free",
+        HubMotion::Fixed => "fixed",
+    };
+    let _ = writeln!(s, "flexcraft modes: {}", scenario.name);
+    let _ = writeln!(
+        s,
+        "basis {}, hub {motion}, {} generalized coordinates, total mass {:.6} kg (SI units: Hz, rad/s, kg, kg·m²)",
+        st.basis.name(),
+        modes.dof,
+        st.total_mass()
+    );
+    let names: Vec<String> = model
+        .elements
+        .iter()
+        .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
+        .map(|e| st.component_name(e.id).to_string())
+        .collect();
+    let _ = write!(s, "\n{:>4}  {:<7} {:>12} {:>12}  {:<10}", "mode", "kind", "f [Hz]", "ω [rad/s]", "dominant");
+    for n in &names {
+        let _ = write!(s, " {:>8}", format!("SE {n}"));
+    }
+    let fixed = st.hub.motion == HubMotion::Fixed;
+    if fixed {
+        for d in DIRECTIONS {
+            let _ = write!(s, " {:>10}", format!("meff {d}"));
+        }
+    }
+    s.push('\n');
+    for m in &modes.modes {
+        let _ = write!(
+            s,
+            "{:>4}  {:<7} {:>12.6} {:>12.6}  {:<10}",
+            m.number,
+            if m.rigid { "rigid" } else { "elastic" },
+            m.frequency_hz(),
+            m.omega_rad_s,
+            m.dominant()
+        );
+        for n in &names {
+            let v = m.strain_energy_share.iter().find(|(k, _)| k == n).map(|x| x.1);
+            match v {
+                Some(v) => {
+                    let _ = write!(s, " {:>8.4}", v);
+                }
+                None => {
+                    let _ = write!(s, " {:>8}", "-");
+                }
+            }
+        }
+        if let Some(e) = m.effective_mass {
+            for v in e {
+                let _ = write!(s, " {:>10.4e}", v);
+            }
+        }
+        s.push('\n');
+    }
+    let fr = modes.effective_mass_fractions();
+    if let Some(last) = fr.last() {
+        let _ = writeln!(
+            s,
+            "\nHub-fixed modes: sum of effective masses / appendage rigid mass (about the hub CM), over all {} modes:",
+            modes.hub_fixed.len()
+        );
+        for (d, v) in DIRECTIONS.iter().zip(last) {
+            let _ = write!(s, "  {d} {:.6}", v);
+        }
+        s.push('\n');
+        if !fixed {
+            let _ = writeln!(s, "Effective masses of each hub-fixed mode: --json (hub_fixed.modes) or modes.json.");
+        }
+    }
+    s
+}
+
+fn csv_num(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// Samples of every elastic component for generalized coordinates q.
+pub(crate) fn sample_all(model: &RitzModel, q: &[f64]) -> Vec<(String, ComponentId, Vec<PointSample>)> {
+    let st = &model.structure;
+    let mut out = Vec::new();
+    for e in &model.elements {
+        let samples = match e.id {
+            ComponentId::Beam(i) => sample_beam(model, i, q, 41),
+            ComponentId::Plate(i) => sample_plate(model, i, q, 31, 9),
+            _ => continue,
+        };
+        out.push((st.component_name(e.id).to_string(), e.id, samples));
+    }
+    out
+}
+
+/// Writes modes.json, frequencies.csv, coefficients/mode_NNN.csv, shapes/mode_NNN.csv and
+/// plots/mode_NNN.{png,svg} (first 12 modes).
+pub fn write_modes(dir: &mut OutputDir, model: &RitzModel, modes: &ModalAnalysis) -> Result<(), OutputError> {
+    let st = &model.structure;
+    dir.write("modes.json", modes_json(model, modes) + "\n")?;
+
+    let names: Vec<String> = model
+        .elements
+        .iter()
+        .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
+        .map(|e| st.component_name(e.id).to_string())
+        .collect();
+    let mut f = String::from("mode,rigid,frequency [Hz],omega [rad/s],dominant");
+    for n in &names {
+        let _ = write!(f, ",strain energy share {n} [-]");
+    }
+    for d in DIRECTIONS {
+        let unit = if d.starts_with('r') { "kg m^2" } else { "kg" };
+        let _ = write!(f, ",effective mass {d} [{unit}]");
+    }
+    f.push('\n');
+    for m in &modes.modes {
+        let _ = write!(f, "{},{},{},{},{}", m.number, m.rigid, csv_num(m.frequency_hz()), csv_num(m.omega_rad_s), m.dominant());
+        for n in &names {
+            let v = m.strain_energy_share.iter().find(|(k, _)| k == n).map_or(0.0, |x| x.1);
+            let _ = write!(f, ",{}", csv_num(v));
+        }
+        for d in 0..6 {
+            match m.effective_mass {
+                Some(e) => {
+                    let _ = write!(f, ",{}", csv_num(e[d]));
+                }
+                None => f.push(','),
+            }
+        }
+        f.push('\n');
+    }
+    dir.write("frequencies.csv", f)?;
+
+    for m in &modes.modes {
+        // Coefficients grouped by component and field: the paper's tables 2.2–2.3.
+        let mut c = String::from("component,field,i,j,coefficient [mass-normalised]\n");
+        if st.hub.motion == HubMotion::Free {
+            for (k, d) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
+                let _ = writeln!(c, "hub,{d},{},,{}", k + 1, csv_num(m.shape[k]));
+            }
+        }
+        for e in &model.elements {
+            let name = st.component_name(e.id);
+            let ny = match (&e.basis, e.id) {
+                (ElementBasis::Plate { width, .. }, _) => width.len(),
+                _ => 0,
+            };
+            for fr in &e.fields {
+                for k in 0..fr.len {
+                    let v = csv_num(m.shape[fr.start + k]);
+                    if ny > 0 {
+                        let _ = writeln!(c, "{name},{},{},{},{v}", fr.field, k / ny + 1, k % ny + 1);
+                    } else {
+                        let _ = writeln!(c, "{name},{},{},,{v}", fr.field, k + 1);
+                    }
+                }
+            }
+        }
+        dir.write(&format!("coefficients/mode_{:03}.csv", m.number), c)?;
+
+        let mut sh = String::from("component,s [m],t [m],x [m],y [m],z [m],ux [m],uy [m],uz [m],rx [rad],ry [rad],rz [rad]\n");
+        for (name, _, samples) in sample_all(model, &m.shape) {
+            for p in samples {
+                let _ = writeln!(
+                    sh,
+                    "{name},{},{},{},{},{},{},{},{},{},{},{}",
+                    csv_num(p.local[0]),
+                    csv_num(p.local[1]),
+                    csv_num(p.position.0[0]),
+                    csv_num(p.position.0[1]),
+                    csv_num(p.position.0[2]),
+                    csv_num(p.displacement.0[0]),
+                    csv_num(p.displacement.0[1]),
+                    csv_num(p.displacement.0[2]),
+                    csv_num(p.rotation.0[0]),
+                    csv_num(p.rotation.0[1]),
+                    csv_num(p.rotation.0[2]),
+                );
+            }
+        }
+        dir.write(&format!("shapes/mode_{:03}.csv", m.number), sh)?;
+    }
+    let first_elastic = modes.modes.iter().position(|m| !m.rigid).unwrap_or(0);
+    for m in modes.modes.iter().skip(first_elastic).take(12) {
+        plot::mode_shape(dir, model, m)?;
+    }
+    Ok(())
+}

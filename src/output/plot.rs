@@ -1,0 +1,137 @@
+//! Pictures (PNG and SVG) drawn with plotters and a bundled font (DejaVu Sans), so that the
+//! output does not depend on the machine's fonts.
+
+use super::{OutputDir, OutputError};
+use crate::ritz::{Mode, RitzModel};
+use crate::structure::ComponentId;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::Once;
+
+static FONT: Once = Once::new();
+
+/// Registers the bundled font as "sans-serif" (once per process).
+pub fn register_font() {
+    FONT.call_once(|| {
+        let bytes: &'static [u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
+    });
+}
+
+type Lines = Vec<Vec<(f64, f64, f64)>>;
+
+/// Undeformed and deformed polylines of every elastic component.
+fn polylines(model: &RitzModel, q: &[f64]) -> (Lines, Lines) {
+    let mut undeformed = Vec::new();
+    let mut deformed = Vec::new();
+    let samples = super::modes::sample_all(model, q);
+    let max_disp = samples.iter().flat_map(|(_, _, s)| s.iter().map(|p| p.displacement.norm())).fold(0.0, f64::max);
+    let extent = samples
+        .iter()
+        .flat_map(|(_, _, s)| s.iter().map(|p| p.position.norm()))
+        .fold(1.0, f64::max);
+    let scale = if max_disp > 0.0 { 0.12 * extent / max_disp } else { 0.0 };
+    for (_, id, s) in &samples {
+        let pos = |p: &crate::ritz::shapes::PointSample| (p.position.0[0], p.position.0[1], p.position.0[2]);
+        let def = |p: &crate::ritz::shapes::PointSample| {
+            let r = p.position + p.displacement * scale;
+            (r.0[0], r.0[1], r.0[2])
+        };
+        match id {
+            ComponentId::Plate(_) => {
+                // Grid 31 × 9, row-major in x: lines along x and along y.
+                let (nx, ny) = (31, 9);
+                for j in 0..ny {
+                    undeformed.push((0..nx).map(|i| pos(&s[i * ny + j])).collect());
+                    deformed.push((0..nx).map(|i| def(&s[i * ny + j])).collect());
+                }
+                for i in (0..nx).step_by(3) {
+                    undeformed.push((0..ny).map(|j| pos(&s[i * ny + j])).collect());
+                    deformed.push((0..ny).map(|j| def(&s[i * ny + j])).collect());
+                }
+            }
+            _ => {
+                undeformed.push(s.iter().map(pos).collect());
+                deformed.push(s.iter().map(def).collect());
+            }
+        }
+    }
+    (undeformed, deformed)
+}
+
+fn draw_view<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    axes: (usize, usize),
+    labels: (&str, &str),
+    und: &Lines,
+    def: &Lines,
+) -> Result<(), String> {
+    let all = und.iter().chain(def.iter()).flatten();
+    let pick = |p: &(f64, f64, f64), i: usize| [p.0, p.1, p.2][i];
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in all {
+        x0 = x0.min(pick(p, axes.0));
+        x1 = x1.max(pick(p, axes.0));
+        y0 = y0.min(pick(p, axes.1));
+        y1 = y1.max(pick(p, axes.1));
+    }
+    // Equal scales on both axes (the drawing areas are square).
+    let span = (x1 - x0).max(y1 - y0).max(1e-9) * 1.1;
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(48)
+        .build_cartesian_2d(cx - span / 2.0..cx + span / 2.0, cy - span / 2.0..cy + span / 2.0)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for l in und {
+        chart
+            .draw_series(LineSeries::new(l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))), RGBColor(170, 170, 170)))
+            .map_err(|e| e.to_string())?;
+    }
+    for l in def {
+        chart
+            .draw_series(LineSeries::new(l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))), RGBColor(20, 90, 200).stroke_width(2)))
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+fn draw_mode<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, model: &RitzModel, mode: &Mode) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let kind = if mode.rigid { "rigid" } else { "elastic" };
+    let title = format!("mode {} ({kind}), f = {:.6} Hz, dominant: {}", mode.number, mode.frequency_hz(), mode.dominant());
+    let root = root.titled(&title, ("sans-serif", 22)).map_err(|e| e.to_string())?;
+    let (und, def) = polylines(model, &mode.shape);
+    let (a, b) = root.split_horizontally(root.dim_in_pixel().0 / 2);
+    draw_view(&a, "side view (x–z), grey: undeformed", (0, 2), ("x [m]", "z [m]"), &und, &def)?;
+    draw_view(&b, "top view (x–y), blue: deformed (exaggerated)", (0, 1), ("x [m]", "y [m]"), &und, &def)?;
+    root.present().map_err(|e| e.to_string())
+}
+
+/// plots/mode_NNN.png and .svg: two orthogonal views of the undeformed (grey) and deformed
+/// (blue, exaggerated) structure.
+pub fn mode_shape(dir: &mut OutputDir, model: &RitzModel, mode: &Mode) -> Result<(), OutputError> {
+    register_font();
+    for ext in ["png", "svg"] {
+        let rel = format!("plots/mode_{:03}.{ext}", mode.number);
+        let path = dir.path(&rel)?;
+        let size = (1200, 640);
+        let r = if ext == "png" {
+            draw_mode(BitMapBackend::new(&path, size).into_drawing_area(), model, mode)
+        } else {
+            draw_mode(SVGBackend::new(&path, size).into_drawing_area(), model, mode)
+        };
+        r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
+    }
+    Ok(())
+}

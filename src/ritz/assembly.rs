@@ -1,0 +1,397 @@
+//! Assembly of the Ritz mass and stiffness matrices (MODEL.md §3.1; the paper's (1.2)–(1.5)).
+//!
+//! Generalized coordinates q: the hub's six (translation of its centre of mass, small
+//! rotation vector), then each beam's own coefficients [u, v, w, θ] (parents before children),
+//! then each plate's g_mn (index m·N_width + n). A component's points move with its parent's
+//! attachment section — translation U and small rotation Θ, both linear in q through the
+//! 6×n *attachment map* T — plus its own deformation:
+//!
+//! u(r) = U + Θ × r + Σ q_k F_k(r),  so with z = [U; Θ; q_own] = B q, B = [T; P],
+//! T = ½ żᵀ M_e ż ⇒ M = Σ Bᵀ M_e B,  Π = ½ q_ownᵀ K_e q_own ⇒ K = Σ Pᵀ K_e P.
+//!
+//! Compatibility holds by construction; nothing is penalised. The element matrices M_e are
+//! written blockwise from the one-dimensional integrals of [`crate::basis::Integrals`]
+//! (plates by Kronecker products), so no two-dimensional quadrature is needed.
+
+use crate::basis::{Basis1d, Integrals};
+use crate::math::Vec3;
+use crate::structure::{Attachment, Beam, ComponentId, Plate, RigidBody, Structure};
+use faer::Mat;
+
+/// A named field of a component's own coordinates (e.g. the mast's `w`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldRange {
+    /// "u", "v", "w", "theta" (beams) or "g" (plates).
+    pub field: &'static str,
+    /// First global index.
+    pub start: usize,
+    /// Number of coordinates.
+    pub len: usize,
+}
+
+/// The Ritz functions of one component.
+#[derive(Debug)]
+pub enum ElementBasis {
+    /// A beam: axial, bending (v and w), torsion.
+    Beam {
+        /// Axial functions.
+        axial: Box<dyn Basis1d>,
+        /// Bending functions (shared by v and w).
+        bending: Box<dyn Basis1d>,
+        /// Torsion functions.
+        torsion: Box<dyn Basis1d>,
+    },
+    /// A plate: X_m along the length, Y_n across the width.
+    Plate {
+        /// Clamped–free functions along the length.
+        length: Box<dyn Basis1d>,
+        /// Free–free functions across the width.
+        width: Box<dyn Basis1d>,
+    },
+    /// A rigid body (hub, lumped mass): no own coordinates.
+    Rigid,
+}
+
+/// One component's place in the assembled model.
+#[derive(Debug)]
+pub struct Element {
+    /// Which component.
+    pub id: ComponentId,
+    /// Its own coordinates, field by field.
+    pub fields: Vec<FieldRange>,
+    /// The attachment map T (6 × n): [U; Θ] of the attachment section = T q.
+    pub attachment: Mat<f64>,
+    /// Structure-frame position of the attachment point.
+    pub origin: Vec3,
+    /// The Ritz functions.
+    pub basis: ElementBasis,
+}
+
+impl Element {
+    /// Global index range of the component's own coordinates.
+    pub fn own_range(&self) -> std::ops::Range<usize> {
+        let start = self.fields.first().map_or(0, |f| f.start);
+        let len: usize = self.fields.iter().map(|f| f.len).sum();
+        start..start + len
+    }
+}
+
+/// The assembled Ritz model: K q = ω² M q.
+#[derive(Debug)]
+pub struct RitzModel {
+    /// The structure.
+    pub structure: Structure,
+    /// Mass matrix (n × n), symmetric positive definite.
+    pub mass: Mat<f64>,
+    /// Stiffness matrix (n × n), symmetric, zero on the hub's six coordinates.
+    pub stiffness: Mat<f64>,
+    /// Components in assembly order (hub first).
+    pub elements: Vec<Element>,
+}
+
+/// Number of hub coordinates (always the first six).
+pub const HUB_DOF: usize = 6;
+
+impl RitzModel {
+    /// Total number of generalized coordinates (hub included).
+    pub fn dof(&self) -> usize {
+        self.mass.nrows()
+    }
+
+    /// Assembles M and K of a structure with its chosen basis.
+    pub fn assemble(structure: &Structure) -> Self {
+        let kind = structure.basis;
+        // Own-coordinate layout first, so that every T has its final width.
+        let mut n = HUB_DOF;
+        let mut layout: Vec<(ComponentId, Vec<FieldRange>, ElementBasis)> = Vec::new();
+        for &i in structure.beam_order() {
+            let t = structure.beams[i].terms;
+            let mut fields = Vec::new();
+            for (field, len) in [("u", t.axial), ("v", t.bending), ("w", t.bending), ("theta", t.torsion)] {
+                fields.push(FieldRange { field, start: n, len });
+                n += len;
+            }
+            let basis = ElementBasis::Beam { axial: kind.rod(t.axial), bending: kind.bending(t.bending), torsion: kind.rod(t.torsion) };
+            layout.push((ComponentId::Beam(i), fields, basis));
+        }
+        for (i, p) in structure.plates.iter().enumerate() {
+            let len = p.terms.dof();
+            let fields = vec![FieldRange { field: "g", start: n, len }];
+            n += len;
+            let basis = ElementBasis::Plate { length: kind.bending(p.terms.length), width: kind.free_free(p.terms.width) };
+            layout.push((ComponentId::Plate(i), fields, basis));
+        }
+        for i in 0..structure.masses.len() {
+            layout.push((ComponentId::Mass(i), Vec::new(), ElementBasis::Rigid));
+        }
+
+        let mut mass = Mat::<f64>::zeros(n, n);
+        let mut stiffness = Mat::<f64>::zeros(n, n);
+        let hub = &structure.hub;
+        let hub_t = hub_map(n, hub.center_of_mass, hub.center_of_mass);
+        add_rigid(&mut mass, &hub_t, &hub.rigid_body());
+        let mut elements = vec![Element {
+            id: ComponentId::Hub,
+            fields: Vec::new(),
+            attachment: hub_t,
+            origin: hub.center_of_mass,
+            basis: ElementBasis::Rigid,
+        }];
+        // Root map of every beam, filled in topological order.
+        let mut beam_elem: Vec<Option<usize>> = vec![None; structure.beams.len()];
+
+        for (id, fields, basis) in layout {
+            let att = match id {
+                ComponentId::Beam(i) => &structure.beams[i].attachment,
+                ComponentId::Plate(i) => &structure.plates[i].attachment,
+                ComponentId::Mass(i) => &structure.masses[i].attachment,
+                ComponentId::Hub => unreachable!("the hub is not in the layout"),
+            };
+            let origin = structure.attachment_point(att);
+            let t = match att {
+                Attachment::Hub { point } => hub_map(n, *point, hub.center_of_mass),
+                Attachment::Beam { beam, station } => {
+                    let bi = structure.beam_index(beam).expect("parents are validated");
+                    let pe = &elements[beam_elem[bi].expect("parents come first")];
+                    section_map(&structure.beams[bi], pe, *station, n)
+                }
+            };
+            let own = fields.first().map_or(0, |f| f.start);
+            match (&id, &basis) {
+                (ComponentId::Beam(i), ElementBasis::Beam { axial, bending, torsion }) => {
+                    let (me, ke) = beam_element(&structure.beams[*i], axial.as_ref(), bending.as_ref(), torsion.as_ref());
+                    add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
+                    beam_elem[*i] = Some(elements.len());
+                }
+                (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
+                    let (me, ke) = plate_element(&structure.plates[*i], length.as_ref(), width.as_ref());
+                    add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
+                }
+                (ComponentId::Mass(i), _) => add_rigid(&mut mass, &t, &structure.masses[*i].rigid_body()),
+                _ => unreachable!("layout pairs ids with their bases"),
+            }
+            elements.push(Element { id, fields, attachment: t, origin, basis });
+        }
+        symmetrize(&mut mass);
+        symmetrize(&mut stiffness);
+        Self { structure: structure.clone(), mass, stiffness, elements }
+    }
+
+    /// The element of a component.
+    pub fn element(&self, id: ComponentId) -> Option<&Element> {
+        self.elements.iter().find(|e| e.id == id)
+    }
+}
+
+fn symmetrize(m: &mut Mat<f64>) {
+    let n = m.nrows();
+    for i in 0..n {
+        for j in 0..i {
+            let v = 0.5 * (m[(i, j)] + m[(j, i)]);
+            m[(i, j)] = v;
+            m[(j, i)] = v;
+        }
+    }
+}
+
+/// T of a point p rigidly fixed to the hub: U = U_hub + Θ × (p − c_hub), rotation Θ.
+fn hub_map(n: usize, p: Vec3, c_hub: Vec3) -> Mat<f64> {
+    let mut t = Mat::zeros(6, n);
+    let s = (p - c_hub).skew();
+    for i in 0..3 {
+        t[(i, i)] = 1.0;
+        t[(3 + i, 3 + i)] = 1.0;
+        for j in 0..3 {
+            t[(i, 3 + j)] = -s.get(i, j);
+        }
+    }
+    t
+}
+
+/// T of the section at `station` of a beam: translation
+/// U + Θ × s e_x + u(s) e_x + v(s) e_y + w(s) e_z, rotation Θ + θ(s) e_x − w'(s) e_y + v'(s) e_z.
+fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64> {
+    let ElementBasis::Beam { axial, bending, torsion } = &parent.basis else {
+        unreachable!("a beam element has a beam basis")
+    };
+    let f = beam.frame;
+    let xi = (station / beam.length).clamp(0.0, 1.0);
+    let tp = &parent.attachment;
+    // Rigid part: [I, −S(s e_x); 0, I] T_parent.
+    let s = (f.ex * station).skew();
+    let mut t = Mat::zeros(6, n);
+    for c in 0..n {
+        let uu = Vec3::new(tp[(0, c)], tp[(1, c)], tp[(2, c)]);
+        let th = Vec3::new(tp[(3, c)], tp[(4, c)], tp[(5, c)]);
+        let tr = uu - s.apply(th);
+        for i in 0..3 {
+            t[(i, c)] = tr.get(i);
+            t[(3 + i, c)] = th.get(i);
+        }
+    }
+    let l = beam.length;
+    let mut put = |col: usize, tr: Vec3, rot: Vec3| {
+        for i in 0..3 {
+            t[(i, col)] += tr.get(i);
+            t[(3 + i, col)] += rot.get(i);
+        }
+    };
+    let fields = &parent.fields;
+    for (k, d) in axial.eval_vec(xi).iter().enumerate() {
+        put(fields[0].start + k, f.ex * d[0], Vec3::ZERO);
+    }
+    for (k, d) in bending.eval_vec(xi).iter().enumerate() {
+        put(fields[1].start + k, f.ey * d[0], f.ez * (d[1] / l));
+        put(fields[2].start + k, f.ez * d[0], f.ey * (-d[1] / l));
+    }
+    for (k, d) in torsion.eval_vec(xi).iter().enumerate() {
+        put(fields[3].start + k, Vec3::ZERO, f.ex * d[0]);
+    }
+    t
+}
+
+fn rigid_block(rb: &RigidBody, ne: usize) -> Mat<f64> {
+    let b = rb.block();
+    let mut me = Mat::zeros(6 + ne, 6 + ne);
+    for i in 0..6 {
+        for j in 0..6 {
+            me[(i, j)] = b[i][j];
+        }
+    }
+    me
+}
+
+fn set_coupling(me: &mut Mat<f64>, col: usize, du: Vec3, dth: Vec3) {
+    for i in 0..3 {
+        me[(i, col)] = du.get(i);
+        me[(col, i)] = du.get(i);
+        me[(3 + i, col)] = dth.get(i);
+        me[(col, 3 + i)] = dth.get(i);
+    }
+}
+
+/// Element matrices over z = [U; Θ; own]: `me` is (6 + n_e)², `ke` is n_e².
+///
+/// Beam element (MODEL.md §3.1):
+/// T = ½∫ρA|U̇ + Θ̇ × x e_x + u̇ e_x + v̇ e_y + ẇ e_z|² + ρI_p(Θ̇·e_x + θ̇)² dx,
+/// U = ½∫(EA u'² + EI_z v''² + EI_y w''² + GJ θ'²) dx.
+pub(crate) fn beam_element(beam: &Beam, axial: &dyn Basis1d, bending: &dyn Basis1d, torsion: &dyn Basis1d) -> (Mat<f64>, Mat<f64>) {
+    let (na, nb, nt) = (axial.len(), bending.len(), torsion.len());
+    let ne = na + 2 * nb + nt;
+    let l = beam.length;
+    let rho_a = beam.mass_per_length();
+    let rho_ip = beam.density * beam.section.polar_inertia;
+    let f = beam.frame;
+    let (ia, ib, it) = (Integrals::new(axial), Integrals::new(bending), Integrals::new(torsion));
+    let mut me = rigid_block(&beam.rigid_body(), ne);
+    let mut ke = Mat::zeros(ne, ne);
+    let (ou, ov, ow, ot) = (6, 6 + na, 6 + na + nb, 6 + na + 2 * nb);
+    for i in 0..na {
+        set_coupling(&mut me, ou + i, f.ex * (rho_a * l * ia.m0[i]), Vec3::ZERO);
+    }
+    for j in 0..nb {
+        set_coupling(&mut me, ov + j, f.ey * (rho_a * l * ib.m0[j]), f.ez * (rho_a * l * l * ib.m1[j]));
+        set_coupling(&mut me, ow + j, f.ez * (rho_a * l * ib.m0[j]), f.ey * (-rho_a * l * l * ib.m1[j]));
+    }
+    for k in 0..nt {
+        set_coupling(&mut me, ot + k, Vec3::ZERO, f.ex * (rho_ip * l * it.m0[k]));
+    }
+    let e = beam.youngs_modulus;
+    let s = beam.section;
+    for i in 0..na {
+        for j in 0..na {
+            me[(ou + i, ou + j)] = rho_a * l * ia.i00[(i, j)];
+            ke[(ou + i - 6, ou + j - 6)] = e * s.area / l * ia.i11[(i, j)];
+        }
+    }
+    for i in 0..nb {
+        for j in 0..nb {
+            let m = rho_a * l * ib.i00[(i, j)];
+            me[(ov + i, ov + j)] = m;
+            me[(ow + i, ow + j)] = m;
+            ke[(ov + i - 6, ov + j - 6)] = e * s.iz / l.powi(3) * ib.i22[(i, j)];
+            ke[(ow + i - 6, ow + j - 6)] = e * s.iy / l.powi(3) * ib.i22[(i, j)];
+        }
+    }
+    for i in 0..nt {
+        for j in 0..nt {
+            me[(ot + i, ot + j)] = rho_ip * l * it.i00[(i, j)];
+            ke[(ot + i - 6, ot + j - 6)] = beam.shear_modulus * s.torsion_constant / l * it.i11[(i, j)];
+        }
+    }
+    (me, ke)
+}
+
+/// Plate element (MODEL.md §3.1): W = Σ g_mn X_m(x/a) Y_n(y/b + ½),
+/// T = ½∫μ|U̇ + Θ̇ × r + Ẇ n|² dA,
+/// U = (D/2)∫[W_xx² + W_yy² + 2ν W_xx W_yy + 2(1 − ν) W_xy²] dA
+/// (= (D/2)∫[(ΔW)² − 2(1−ν)(W_xx W_yy − W_xy²)] dA).
+pub(crate) fn plate_element(plate: &Plate, xb: &dyn Basis1d, yb: &dyn Basis1d) -> (Mat<f64>, Mat<f64>) {
+    let (nx, ny) = (xb.len(), yb.len());
+    let ne = nx * ny;
+    let (a, b) = (plate.length, plate.width);
+    let mu = plate.areal_density;
+    let (d, nu) = (plate.bending_stiffness, plate.poisson_ratio);
+    let (ix, iy) = (Integrals::new(xb), Integrals::new(yb));
+    let (ea, eb, nn) = (plate.length_axis, plate.width_axis(), plate.normal);
+    let mut me = rigid_block(&plate.rigid_body(), ne);
+    let mut ke = Mat::zeros(ne, ne);
+    let area = a * b;
+    for m in 0..nx {
+        for n in 0..ny {
+            let k = m * ny + n;
+            let mean_x = a * ix.m1[m] * iy.m0[n];
+            let mean_y = ix.m0[m] * b * (iy.m1[n] - 0.5 * iy.m0[n]);
+            set_coupling(&mut me, 6 + k, nn * (mu * area * ix.m0[m] * iy.m0[n]), (eb * -mean_x + ea * mean_y) * (mu * area));
+        }
+    }
+    let (a2b2, a4, b4) = (a * a * b * b, a.powi(4), b.powi(4));
+    for m in 0..nx {
+        for p in 0..nx {
+            for n in 0..ny {
+                for q in 0..ny {
+                    let (k, l) = (m * ny + n, p * ny + q);
+                    me[(6 + k, 6 + l)] = mu * area * ix.i00[(m, p)] * iy.i00[(n, q)];
+                    let kxx = ix.i22[(m, p)] * iy.i00[(n, q)] / a4;
+                    let kyy = ix.i00[(m, p)] * iy.i22[(n, q)] / b4;
+                    let kxy = nu * (ix.i20[(m, p)] * iy.i20[(q, n)] + ix.i20[(p, m)] * iy.i20[(n, q)]) / a2b2;
+                    let ktw = 2.0 * (1.0 - nu) * ix.i11[(m, p)] * iy.i11[(n, q)] / a2b2;
+                    ke[(k, l)] = d * area * (kxx + kyy + kxy + ktw);
+                }
+            }
+        }
+    }
+    (me, ke)
+}
+
+/// M += Tᵀ B T for a rigid body's 6×6 block B.
+fn add_rigid(mass: &mut Mat<f64>, t: &Mat<f64>, rb: &RigidBody) {
+    let b = rigid_block(rb, 0);
+    let bt = &b * t;
+    let tbt = t.transpose() * &bt;
+    add_into(mass, 0, 0, &tbt);
+}
+
+fn add_into(dst: &mut Mat<f64>, r0: usize, c0: usize, src: &Mat<f64>) {
+    for j in 0..src.ncols() {
+        for i in 0..src.nrows() {
+            dst[(r0 + i, c0 + j)] += src[(i, j)];
+        }
+    }
+}
+
+/// M += Bᵀ M_e B and K[own, own] += K_e with B = [T; P_own].
+fn add_element(mass: &mut Mat<f64>, stiffness: &mut Mat<f64>, t: &Mat<f64>, own: usize, me: &Mat<f64>, ke: &Mat<f64>) {
+    let ne = ke.nrows();
+    let mrr = me.submatrix(0, 0, 6, 6).to_owned();
+    let mro = me.submatrix(0, 6, 6, ne).to_owned();
+    let moo = me.submatrix(6, 6, ne, ne).to_owned();
+    let tbt = t.transpose() * (&mrr * t);
+    add_into(mass, 0, 0, &tbt);
+    let tro = t.transpose() * &mro; // n × ne
+    add_into(mass, 0, own, &tro);
+    let ort = tro.transpose().to_owned();
+    add_into(mass, own, 0, &ort);
+    add_into(mass, own, own, &moo);
+    add_into(stiffness, own, own, ke);
+}

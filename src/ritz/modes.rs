@@ -1,0 +1,255 @@
+//! Natural modes of the assembled model (MODEL.md §3.1 "Modes").
+//!
+//! Because the stiffness acts on the components' own coordinates only (K = diag(0₆, K_ee)
+//! with K_ee positive definite for root-clamped bases), the modes are found by partition
+//! rather than by letting the eigensolver find six numerically-zero roots:
+//! * hub fixed: K_ee φ = ω² M_ee φ;
+//! * hub free: the hub's momentum equation gives φ_r = −M_rr⁻¹ M_re φ_e, leaving
+//!   K_ee φ_e = ω² (M_ee − M_er M_rr⁻¹ M_re) φ_e for the elastic modes; the six rigid
+//!   modes are exact (ω = 0): translations of the whole structure and rotations about its
+//!   centre of mass along the principal axes, mass-normalised.
+//!
+//! Modal effective masses are those of the hub-fixed modes, with respect to the hub's six
+//! coordinates (translation of, and rotation about, the hub's centre of mass):
+//! m_eff,i,d = (φ_iᵀ M_e,d)², whose sum over a complete basis is the appendages' rigid mass.
+
+use super::assembly::{ElementBasis, RitzModel, HUB_DOF};
+use super::eigen::generalized_symmetric;
+use super::RitzError;
+use crate::math::Vec3;
+use crate::structure::{Attachment, ComponentId, HubMotion, RigidBody};
+use faer::{Mat, Side};
+
+/// One natural mode.
+#[derive(Debug, Clone)]
+pub struct Mode {
+    /// 1-based number: rigid modes first, then elastic ones by ascending frequency.
+    pub number: usize,
+    /// Rigid-body (zero-frequency) mode.
+    pub rigid: bool,
+    /// Circular frequency ω, rad/s.
+    pub omega_rad_s: f64,
+    /// Generalized coordinates of the mass-normalised shape (φᵀMφ = 1).
+    pub shape: Vec<f64>,
+    /// Strain-energy share of each elastic component (sums to 1; empty for rigid modes).
+    pub strain_energy_share: Vec<(String, f64)>,
+    /// Modal effective mass in the hub's six directions [kg, kg, kg, kg·m², kg·m², kg·m²]
+    /// (elastic modes of a fixed hub).
+    pub effective_mass: Option<[f64; 6]>,
+}
+
+impl Mode {
+    /// Frequency f = ω/2π, Hz.
+    pub fn frequency_hz(&self) -> f64 {
+        self.omega_rad_s / (2.0 * std::f64::consts::PI)
+    }
+
+    /// The component with the largest strain-energy share ("rigid" for rigid modes).
+    pub fn dominant(&self) -> &str {
+        self.strain_energy_share
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or("rigid", |(n, _)| n.as_str())
+    }
+}
+
+/// An elastic mode of the hub-fixed system with its effective masses.
+#[derive(Debug, Clone)]
+pub struct HubFixedMode {
+    /// ω, rad/s.
+    pub omega_rad_s: f64,
+    /// Effective masses, hub directions [x, y, z, rx, ry, rz].
+    pub effective_mass: [f64; 6],
+}
+
+/// The result of a modal analysis.
+#[derive(Debug, Clone)]
+pub struct ModalAnalysis {
+    /// Number of generalized coordinates of the solved system (hub's six included if free).
+    pub dof: usize,
+    /// Hub motion.
+    pub hub_motion: HubMotion,
+    /// Every mode, rigid first.
+    pub modes: Vec<Mode>,
+    /// Elastic modes of the hub-fixed system (the same as `modes` for a fixed hub).
+    pub hub_fixed: Vec<HubFixedMode>,
+    /// Rigid mass of the appendages (everything not rigidly part of the hub) in the hub's six
+    /// directions, about the hub's centre of mass: the limit of the effective-mass sums.
+    pub appendage_mass: [f64; 6],
+}
+
+impl ModalAnalysis {
+    /// Solves for every mode of the model.
+    pub fn compute(model: &RitzModel) -> Result<Self, RitzError> {
+        let n = model.dof();
+        let ne = n - HUB_DOF;
+        let m = &model.mass;
+        let k = &model.stiffness;
+        let mee = m.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
+        let kee = k.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
+        let mer = m.submatrix(HUB_DOF, 0, ne, HUB_DOF).to_owned();
+        let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
+
+        let (lam_f, phi_f) = generalized_symmetric(&kee, &mee)?;
+        let hub_fixed: Vec<HubFixedMode> = (0..ne)
+            .map(|j| {
+                let mut eff = [0.0; 6];
+                for (d, e) in eff.iter_mut().enumerate() {
+                    let l: f64 = (0..ne).map(|i| phi_f[(i, j)] * mer[(i, d)]).sum();
+                    *e = l * l;
+                }
+                HubFixedMode { omega_rad_s: lam_f[j].max(0.0).sqrt(), effective_mass: eff }
+            })
+            .collect();
+        let appendage_mass = appendage_mass(model, &mrr);
+
+        let mut modes = Vec::new();
+        let motion = model.structure.hub.motion;
+        match motion {
+            HubMotion::Fixed => {
+                for j in 0..ne {
+                    let mut shape = vec![0.0; n];
+                    for i in 0..ne {
+                        shape[HUB_DOF + i] = phi_f[(i, j)];
+                    }
+                    modes.push(elastic_mode(model, lam_f[j], shape, Some(hub_fixed[j].effective_mass)));
+                }
+            }
+            HubMotion::Free => {
+                modes.extend(rigid_modes(model, &mrr));
+                // M̃ = M_ee − M_er M_rr⁻¹ M_re.
+                let llt = mrr.llt(Side::Lower).map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
+                let mut x = mer.transpose().to_owned(); // 6 × ne → M_rr⁻¹ M_re
+                faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
+                let corr = &mer * &x;
+                let mt = Mat::from_fn(ne, ne, |i, j| mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)]));
+                let (lam, phi) = generalized_symmetric(&kee, &mt)?;
+                for j in 0..ne {
+                    let mut shape = vec![0.0; n];
+                    for i in 0..ne {
+                        shape[HUB_DOF + i] = phi[(i, j)];
+                    }
+                    for r in 0..HUB_DOF {
+                        shape[r] = -(0..ne).map(|i| x[(r, i)] * phi[(i, j)]).sum::<f64>();
+                    }
+                    modes.push(elastic_mode(model, lam[j], shape, None));
+                }
+            }
+        }
+        for (i, md) in modes.iter_mut().enumerate() {
+            md.number = i + 1;
+        }
+        let dof = match motion {
+            HubMotion::Free => n,
+            HubMotion::Fixed => ne,
+        };
+        Ok(Self { dof, hub_motion: motion, modes, hub_fixed, appendage_mass })
+    }
+
+    /// Elastic modes only.
+    pub fn elastic(&self) -> impl Iterator<Item = &Mode> {
+        self.modes.iter().filter(|m| !m.rigid)
+    }
+
+    /// Running sum of the hub-fixed effective masses as fractions of the appendage mass, per
+    /// direction, after each mode.
+    pub fn effective_mass_fractions(&self) -> Vec<[f64; 6]> {
+        let mut run = [0.0; 6];
+        self.hub_fixed
+            .iter()
+            .map(|m| {
+                for d in 0..6 {
+                    run[d] += m.effective_mass[d];
+                }
+                std::array::from_fn(|d| if self.appendage_mass[d] > 0.0 { run[d] / self.appendage_mass[d] } else { 0.0 })
+            })
+            .collect()
+    }
+}
+
+/// Sign convention: the largest-magnitude coordinate is positive (deterministic output).
+fn fix_sign(shape: &mut [f64]) {
+    let big = shape.iter().copied().fold(0.0f64, |acc, v| if v.abs() > acc.abs() * (1.0 + 1e-9) { v } else { acc });
+    if big < 0.0 {
+        for v in shape.iter_mut() {
+            *v = -*v;
+        }
+    }
+}
+
+fn elastic_mode(model: &RitzModel, lambda: f64, mut shape: Vec<f64>, eff: Option<[f64; 6]>) -> Mode {
+    fix_sign(&mut shape);
+    let k = &model.stiffness;
+    let mut shares = Vec::new();
+    for e in &model.elements {
+        if matches!(e.basis, ElementBasis::Rigid) {
+            continue;
+        }
+        let r = e.own_range();
+        let mut en = 0.0;
+        for i in r.clone() {
+            for j in r.clone() {
+                en += shape[i] * k[(i, j)] * shape[j];
+            }
+        }
+        shares.push((model.structure.component_name(e.id).to_string(), 0.5 * en));
+    }
+    let total: f64 = shares.iter().map(|s| s.1).sum();
+    for s in &mut shares {
+        s.1 = if total > 0.0 { s.1 / total } else { 0.0 };
+    }
+    Mode { number: 0, rigid: false, omega_rad_s: lambda.max(0.0).sqrt(), shape, strain_energy_share: shares, effective_mass: eff }
+}
+
+/// The six exact rigid-body modes of the free structure.
+fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
+    let n = model.dof();
+    let mass = mrr[(0, 0)];
+    // M_rr = [[mI, −S(s)], [S(s), J]] about the hub's CM; s = m d.
+    let s = Vec3::new(mrr[(5, 1)], mrr[(3, 2)], mrr[(4, 0)]);
+    let d = s * (1.0 / mass);
+    let j = crate::math::Mat3(std::array::from_fn(|a| std::array::from_fn(|b| mrr[(3 + a, 3 + b)])));
+    let rb = RigidBody { mass, first_moment: s, inertia: j };
+    let (principal, axes) = rb.inertia_at_cm().symmetric_eigen();
+    let mut out = Vec::new();
+    for a in 0..3 {
+        let mut shape = vec![0.0; n];
+        shape[a] = 1.0 / mass.sqrt();
+        out.push(Mode { number: 0, rigid: true, omega_rad_s: 0.0, shape, strain_energy_share: Vec::new(), effective_mass: None });
+    }
+    for (a, &ia) in principal.iter().enumerate() {
+        let axis = Vec3::new(axes.get(0, a), axes.get(1, a), axes.get(2, a));
+        let th = axis * (1.0 / ia.sqrt());
+        // Rotation about the system CM: the hub CM (at −d from it) moves by Θ × (−d).
+        let u = th.cross(-d);
+        let mut shape = vec![0.0; n];
+        for i in 0..3 {
+            shape[i] = u.get(i);
+            shape[3 + i] = th.get(i);
+        }
+        fix_sign(&mut shape);
+        out.push(Mode { number: 0, rigid: true, omega_rad_s: 0.0, shape, strain_energy_share: Vec::new(), effective_mass: None });
+    }
+    let _ = n;
+    out
+}
+
+/// Diagonal of the appendages' rigid mass in the hub coordinates: M_rr minus the hub itself
+/// and the lumped masses fixed directly to it.
+fn appendage_mass(model: &RitzModel, mrr: &Mat<f64>) -> [f64; 6] {
+    let st = &model.structure;
+    let c = st.hub.center_of_mass;
+    let mut own = st.hub.rigid_body();
+    for lm in &st.masses {
+        if let Attachment::Hub { point } = lm.attachment {
+            own = own.plus(&lm.rigid_body().about(c - point));
+        }
+    }
+    let b = own.block();
+    std::array::from_fn(|d| mrr[(d, d)] - b[d][d])
+}
+
+/// Helper for callers: is this element an elastic component?
+pub fn is_elastic(id: ComponentId) -> bool {
+    matches!(id, ComponentId::Beam(_) | ComponentId::Plate(_))
+}

@@ -1,0 +1,102 @@
+//! Displacement fields of the assembled model: the structure-frame displacement of any point
+//! of a component for a vector of generalized coordinates q (a mode shape or a response).
+
+use super::assembly::{Element, ElementBasis, RitzModel};
+use crate::math::Vec3;
+use crate::structure::ComponentId;
+
+/// One sampled point of a component.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointSample {
+    /// Local coordinates: (x, 0) along a beam, (x, y) on a plate, m.
+    pub local: [f64; 2],
+    /// Undeformed position, structure frame, m.
+    pub position: Vec3,
+    /// Displacement, structure frame (units of q times metres per unit of q).
+    pub displacement: Vec3,
+    /// Small rotation of the section (beams: includes the twist θ about the axis), rad per unit q.
+    pub rotation: Vec3,
+}
+
+fn attachment_motion(e: &Element, q: &[f64]) -> (Vec3, Vec3) {
+    let t = &e.attachment;
+    let mut v = [0.0; 6];
+    for (r, vr) in v.iter_mut().enumerate() {
+        *vr = (0..q.len()).map(|c| t[(r, c)] * q[c]).sum();
+    }
+    (Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]))
+}
+
+/// Samples a beam at `n` equally spaced stations (root and tip included).
+pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<PointSample> {
+    let Some(e) = model.element(ComponentId::Beam(beam)) else { return Vec::new() };
+    let ElementBasis::Beam { axial, bending, torsion } = &e.basis else { return Vec::new() };
+    let b = &model.structure.beams[beam];
+    let f = b.frame;
+    let (u0, th0) = attachment_motion(e, q);
+    let coeff = |k: usize| &q[e.fields[k].start..e.fields[k].start + e.fields[k].len];
+    (0..n)
+        .map(|i| {
+            let xi = i as f64 / (n.max(2) - 1) as f64;
+            let x = xi * b.length;
+            let sum = |basis: &dyn crate::basis::Basis1d, c: &[f64], d: usize| -> f64 {
+                basis.eval_vec(xi).iter().zip(c).map(|(v, ci)| v[d] * ci).sum()
+            };
+            let u = sum(axial.as_ref(), coeff(0), 0);
+            let v = sum(bending.as_ref(), coeff(1), 0);
+            let w = sum(bending.as_ref(), coeff(2), 0);
+            let dv = sum(bending.as_ref(), coeff(1), 1) / b.length;
+            let dw = sum(bending.as_ref(), coeff(2), 1) / b.length;
+            let th = sum(torsion.as_ref(), coeff(3), 0);
+            let r = f.ex * x;
+            PointSample {
+                local: [x, 0.0],
+                position: e.origin + r,
+                displacement: u0 + th0.cross(r) + f.ex * u + f.ey * v + f.ez * w,
+                rotation: th0 + f.ex * th - f.ey * dw + f.ez * dv,
+            }
+        })
+        .collect()
+}
+
+/// Samples a plate on an `nx` × `ny` grid (edges included), row-major in x.
+pub fn sample_plate(model: &RitzModel, plate: usize, q: &[f64], nx: usize, ny: usize) -> Vec<PointSample> {
+    let Some(e) = model.element(ComponentId::Plate(plate)) else { return Vec::new() };
+    let ElementBasis::Plate { length, width } = &e.basis else { return Vec::new() };
+    let p = &model.structure.plates[plate];
+    let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
+    let (u0, th0) = attachment_motion(e, q);
+    let g = &q[e.fields[0].start..e.fields[0].start + e.fields[0].len];
+    let nyb = width.len();
+    let mut out = Vec::with_capacity(nx * ny);
+    let yv: Vec<Vec<[f64; 4]>> = (0..ny).map(|j| width.eval_vec(j as f64 / (ny.max(2) - 1) as f64)).collect();
+    for i in 0..nx {
+        let xi = i as f64 / (nx.max(2) - 1) as f64;
+        let xv = length.eval_vec(xi);
+        for (j, yvals) in yv.iter().enumerate() {
+            let eta = j as f64 / (ny.max(2) - 1) as f64;
+            let mut w = 0.0;
+            let (mut wx, mut wy) = (0.0, 0.0);
+            for (m, xm) in xv.iter().enumerate() {
+                for (nidx, yn) in yvals.iter().enumerate() {
+                    let c = g[m * nyb + nidx];
+                    w += c * xm[0] * yn[0];
+                    wx += c * xm[1] * yn[0];
+                    wy += c * xm[0] * yn[1];
+                }
+            }
+            let (x, y) = (xi * p.length, (eta - 0.5) * p.width);
+            let r = ea * x + eb * y;
+            // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
+            let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
+            out.push(PointSample { local: [x, y], position: e.origin + r, displacement: u0 + th0.cross(r) + nn * w, rotation: rot });
+        }
+    }
+    out
+}
+
+/// Translation of the hub's centre of mass and its small rotation, for q over all
+/// coordinates (hub first).
+pub fn hub_motion(q: &[f64]) -> (Vec3, Vec3) {
+    (Vec3::new(q[0], q[1], q[2]), Vec3::new(q[3], q[4], q[5]))
+}

@@ -1,0 +1,56 @@
+//! Scenario errors: every refusal names the file, line:column, key and reason.
+
+use thiserror::Error;
+
+/// What kind of problem the scenario has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// The file could not be read.
+    Io,
+    /// Not valid TOML.
+    Syntax,
+    /// Valid TOML, but an unknown or missing key, or a value of the wrong type.
+    Schema,
+    /// A value that is not physical or not consistent with the rest.
+    Invalid,
+}
+
+/// A 1-based line and column (columns count characters).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Location {
+    /// Line, from 1.
+    pub line: usize,
+    /// Column, from 1.
+    pub column: usize,
+}
+
+impl Location {
+    /// Location of a byte offset in `src`.
+    pub fn of_offset(src: &str, offset: usize) -> Self {
+        let offset = offset.min(src.len());
+        let mut o = offset;
+        while !src.is_char_boundary(o) {
+            o -= 1;
+        }
+        let before = &src[..o];
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        Self { line, column: src[line_start..o].chars().count() + 1 }
+    }
+}
+
+/// A scenario refused, with where and why.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("{file}:{}:{}: {key}: {reason}", location.line, location.column)]
+pub struct ScenarioError {
+    /// Kind of problem.
+    pub kind: ErrorKind,
+    /// The file (as given by the caller).
+    pub file: String,
+    /// Where in the file.
+    pub location: Location,
+    /// The key, as a dotted path (e.g. `beams[0].section.tube.wall`).
+    pub key: String,
+    /// Why it is refused.
+    pub reason: String,
+}

@@ -1,0 +1,157 @@
+//! The TOML schema, format version 1 (docs/scenario.md). Every value keeps its span so that
+//! validation can point at it. Unknown keys are errors.
+
+use crate::basis::BasisKind;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+pub type S<T> = Spanned<T>;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    pub format_version: Option<S<i64>>,
+    pub name: Option<S<String>>,
+    pub hub: S<RawHub>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, S<RawMaterial>>,
+    #[serde(default)]
+    pub beams: Vec<S<RawBeam>>,
+    #[serde(default)]
+    pub plates: Vec<S<RawPlate>>,
+    #[serde(default)]
+    pub masses: Vec<S<RawMass>>,
+    pub ritz: Option<S<RawRitz>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawMotion {
+    Free,
+    Fixed,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHub {
+    pub motion: S<RawMotion>,
+    pub mass: Option<S<f64>>,
+    pub inertia: Option<S<Vec<f64>>>,
+    pub center_of_mass: Option<S<[f64; 3]>>,
+    pub shape: Option<S<RawHubShape>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHubShape {
+    pub cylinder: S<RawCylinder>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCylinder {
+    pub diameter: S<f64>,
+    pub wall: S<f64>,
+    pub length: S<f64>,
+    pub axis: S<[f64; 3]>,
+    pub center: S<[f64; 3]>,
+    pub material: S<String>,
+    #[serde(default)]
+    pub closed_ends: bool,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMaterial {
+    pub youngs_modulus: S<f64>,
+    pub poisson_ratio: S<f64>,
+    pub shear_modulus: Option<S<f64>>,
+    pub density: S<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTube {
+    pub outer_diameter: S<f64>,
+    pub wall: S<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSection {
+    pub tube: Option<S<RawTube>>,
+    pub area: Option<S<f64>>,
+    pub iy: Option<S<f64>>,
+    pub iz: Option<S<f64>>,
+    pub torsion_constant: Option<S<f64>>,
+    pub polar_inertia: Option<S<f64>>,
+    pub y_axis: Option<S<[f64; 3]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBeamTerms {
+    pub bending: Option<S<i64>>,
+    pub torsion: Option<S<i64>>,
+    pub axial: Option<S<i64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBeam {
+    pub name: S<String>,
+    pub parent: S<String>,
+    pub root: Option<S<[f64; 3]>>,
+    pub station: Option<S<f64>>,
+    pub axis: S<[f64; 3]>,
+    pub length: S<f64>,
+    pub material: S<String>,
+    pub section: S<RawSection>,
+    pub terms: Option<S<RawBeamTerms>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPlateTerms {
+    pub length: Option<S<i64>>,
+    pub width: Option<S<i64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPlate {
+    pub name: S<String>,
+    pub parent: S<String>,
+    pub station: Option<S<f64>>,
+    pub root: Option<S<[f64; 3]>>,
+    pub length_axis: S<[f64; 3]>,
+    pub normal: S<[f64; 3]>,
+    pub length: S<f64>,
+    pub width: S<f64>,
+    pub thickness: Option<S<f64>>,
+    pub material: Option<S<String>>,
+    pub areal_density: Option<S<f64>>,
+    pub bending_stiffness: Option<S<f64>>,
+    pub poisson_ratio: Option<S<f64>>,
+    pub terms: Option<S<RawPlateTerms>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMass {
+    pub name: S<String>,
+    pub parent: S<String>,
+    pub station: Option<S<f64>>,
+    pub point: Option<S<[f64; 3]>>,
+    pub offset: Option<S<[f64; 3]>>,
+    pub mass: S<f64>,
+    pub inertia: Option<S<Vec<f64>>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRitz {
+    #[serde(default)]
+    pub basis: BasisKind,
+}
