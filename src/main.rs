@@ -59,9 +59,9 @@ fn run_modes(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) 
         }
     };
     if json {
-        println!("{}", output::modes_json(&model, &modes));
+        emit(&(output::modes_json(&model, &modes) + "\n"));
     } else {
-        print!("{}", output::modes_table(&scenario, &model, &modes));
+        emit(&output::modes_table(&scenario, &model, &modes));
     }
     if let Some(dir) = out {
         let written = OutputDir::create(dir).and_then(|mut d| {
@@ -81,4 +81,11 @@ fn run_modes(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) 
         }
     }
     ExitCode::SUCCESS
+}
+
+/// Prints to stdout; a closed pipe (`flexcraft modes … | head`) is not an error.
+fn emit(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
 }

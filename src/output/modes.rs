@@ -100,12 +100,6 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
     for n in &names {
         let _ = write!(s, " {:>8}", format!("SE {n}"));
     }
-    let fixed = st.hub.motion == HubMotion::Fixed;
-    if fixed {
-        for d in DIRECTIONS {
-            let _ = write!(s, " {:>10}", format!("meff {d}"));
-        }
-    }
     s.push('\n');
     for m in &modes.modes {
         let _ = write!(
@@ -128,27 +122,32 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
                 }
             }
         }
-        if let Some(e) = m.effective_mass {
-            for v in e {
-                let _ = write!(s, " {:>10.4e}", v);
-            }
-        }
         s.push('\n');
     }
     let fr = modes.effective_mass_fractions();
-    if let Some(last) = fr.last() {
-        let _ = writeln!(
-            s,
-            "\nHub-fixed modes: sum of effective masses / appendage rigid mass (about the hub CM), over all {} modes:",
-            modes.hub_fixed.len()
-        );
-        for (d, v) in DIRECTIONS.iter().zip(last) {
-            let _ = write!(s, "  {d} {:.6}", v);
+    let _ = writeln!(
+        s,
+        "\nHub-fixed elastic modes: modal effective mass in the hub's six directions (kg; kg·m² about the hub CM)\n\
+         and the running sum as a fraction of the appendage mass [{}]:",
+        modes.appendage_mass.iter().map(|v| format!("{v:.6e}")).collect::<Vec<_>>().join(", ")
+    );
+    let _ = write!(s, "{:>4} {:>12}", "mode", "f [Hz]");
+    for d in DIRECTIONS {
+        let _ = write!(s, " {:>10}", format!("meff {d}"));
+    }
+    for d in DIRECTIONS {
+        let _ = write!(s, " {:>8}", format!("Σ {d}"));
+    }
+    s.push('\n');
+    for (i, (m, f)) in modes.hub_fixed.iter().zip(&fr).enumerate() {
+        let _ = write!(s, "{:>4} {:>12.6}", i + 1, m.omega_rad_s / (2.0 * std::f64::consts::PI));
+        for v in m.effective_mass {
+            let _ = write!(s, " {:>10.4e}", v);
+        }
+        for v in f {
+            let _ = write!(s, " {:>8.5}", v);
         }
         s.push('\n');
-        if !fixed {
-            let _ = writeln!(s, "Effective masses of each hub-fixed mode: --json (hub_fixed.modes) or modes.json.");
-        }
     }
     s
 }

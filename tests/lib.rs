@@ -1,0 +1,7 @@
+//! flexcraft's test suite, one binary (`cargo test --release`). Every test asserts against an
+//! independent truth: high-precision reference data, a closed-form or transcendental solution,
+//! a published table (cited where used), a conservation law or a second formulation.
+
+mod suite {
+    pub mod beam_functions;
+}
