@@ -4,4 +4,7 @@
 
 mod suite {
     pub mod beam_functions;
+    pub mod common;
+    pub mod exact_beams;
+    pub mod plates;
 }

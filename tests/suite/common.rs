@@ -1,0 +1,112 @@
+//! Helpers shared by the test modules: build scenarios from TOML text and solve them.
+
+use flexcraft::{ModalAnalysis, RitzModel, Scenario};
+
+/// Parses a scenario given as TOML text (panics with the error report on failure).
+pub fn scenario(toml: &str) -> Scenario {
+    Scenario::from_toml_str(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Assembles and solves a scenario.
+pub fn solve(toml: &str) -> (RitzModel, ModalAnalysis) {
+    let s = scenario(toml);
+    let model = RitzModel::assemble(&s.structure);
+    let modes = ModalAnalysis::compute(&model).expect("modal analysis");
+    (model, modes)
+}
+
+/// Elastic circular frequencies ω [rad/s], ascending.
+pub fn elastic_omegas(modes: &ModalAnalysis) -> Vec<f64> {
+    modes.elastic().map(|m| m.omega_rad_s).collect()
+}
+
+/// A fixed-hub cantilever plate of length 1, width 1/aspect, D = ρh = 1 (so λ = ω).
+pub fn cfff_plate(aspect: f64, basis: &str, nl: usize, nw: usize) -> String {
+    format!(
+        r#"
+name = "CFFF plate"
+[hub]
+motion = "fixed"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[[plates]]
+name = "plate"
+parent = "hub"
+root = [0.0, 0.0, 0.0]
+length_axis = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+length = 1.0
+width = {w}
+areal_density = 1.0
+bending_stiffness = 1.0
+poisson_ratio = 0.3
+terms = {{ length = {nl}, width = {nw} }}
+[ritz]
+basis = "{basis}"
+"#,
+        w = 1.0 / aspect
+    )
+}
+
+/// Bisection for a sign change of f on [a, b] to machine precision.
+pub fn bisect(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let mut fa = f(a);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        let fm = f(m);
+        if (fm > 0.0) == (fa > 0.0) {
+            a = m;
+            fa = fm;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Every sign change of f on a fine grid over [a, b], refined by bisection.
+pub fn roots(f: impl Fn(f64) -> f64, a: f64, b: f64, steps: usize) -> Vec<f64> {
+    let h = (b - a) / steps as f64;
+    let mut out = Vec::new();
+    let mut x0 = a;
+    let mut f0 = f(a);
+    for i in 1..=steps {
+        let x1 = a + h * i as f64;
+        let f1 = f(x1);
+        if f0.is_finite() && f1.is_finite() && (f0 > 0.0) != (f1 > 0.0) {
+            out.push(bisect(&f, x0, x1));
+        }
+        x0 = x1;
+        f0 = f1;
+    }
+    out
+}
+
+/// Determinant of a 4×4 matrix (Laplace expansion).
+pub fn det4(m: [[f64; 4]; 4]) -> f64 {
+    let minor = |r: usize, c: usize| -> f64 {
+        let mut s = [[0.0; 3]; 3];
+        let mut ri = 0;
+        for (i, row) in m.iter().enumerate() {
+            if i == r {
+                continue;
+            }
+            let mut ci = 0;
+            for (j, v) in row.iter().enumerate() {
+                if j == c {
+                    continue;
+                }
+                s[ri][ci] = *v;
+                ci += 1;
+            }
+            ri += 1;
+        }
+        s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1]) - s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0])
+            + s[0][2] * (s[1][0] * s[2][1] - s[1][1] * s[2][0])
+    };
+    (0..4).map(|c| if c % 2 == 0 { 1.0 } else { -1.0 } * m[0][c] * minor(0, c)).sum()
+}
