@@ -6,5 +6,6 @@ mod suite {
     pub mod beam_functions;
     pub mod common;
     pub mod exact_beams;
+    pub mod modal_properties;
     pub mod plates;
 }

@@ -1,0 +1,127 @@
+//! Properties every assembled model and modal solution must have, checked on the bundled
+//! examples: symmetry and definiteness, exact rigid-body mass properties (against the
+//! components' closed-form mass properties, a second formulation), six rigid modes of a free
+//! hub, mass-orthonormality, and the completeness of the modal effective masses.
+
+use super::common::solve;
+use faer::Side;
+use flexcraft::ritz::assembly::HUB_DOF;
+
+const SEED: &str = include_str!("../../examples/seed.toml");
+const FULL: &str = include_str!("../../examples/full.toml");
+
+fn max_abs(m: &faer::Mat<f64>) -> f64 {
+    let mut s = 0.0_f64;
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            s = s.max(m[(i, j)].abs());
+        }
+    }
+    s
+}
+
+#[test]
+fn mass_and_stiffness_are_symmetric_and_mass_is_positive_definite() {
+    for src in [SEED, FULL] {
+        let (model, _) = solve(src);
+        let (m, k) = (&model.mass, &model.stiffness);
+        let n = m.nrows();
+        for i in 0..n {
+            for j in 0..n {
+                assert!((m[(i, j)] - m[(j, i)]).abs() <= 1e-12 * max_abs(m));
+                assert!((k[(i, j)] - k[(j, i)]).abs() <= 1e-12 * max_abs(k));
+            }
+        }
+        assert!(m.llt(Side::Lower).is_ok(), "M not positive definite");
+    }
+}
+
+#[test]
+fn rigid_block_reproduces_total_mass_centre_of_mass_and_inertia() {
+    for src in [SEED, FULL] {
+        let (model, _) = solve(src);
+        let st = &model.structure;
+        // The hub's coordinates are the translation of, and rotation about, its centre of
+        // mass: the rigid part of M is the whole structure's 6×6 mass block about that point.
+        let body = st.rigid_body().about(st.hub.center_of_mass);
+        let block = body.block();
+        let scale = block.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for (i, row) in block.iter().enumerate() {
+            for (j, want) in row.iter().enumerate() {
+                let got = model.mass[(i, j)];
+                assert!((got - want).abs() <= 1e-10 * scale, "M[{i}][{j}] = {got}, rigid body {want}");
+            }
+        }
+        assert!((model.mass[(0, 0)] - st.total_mass()).abs() <= 1e-10 * st.total_mass());
+    }
+}
+
+#[test]
+fn free_hub_has_exactly_six_rigid_modes_and_modes_are_mass_orthonormal() {
+    for src in [SEED, FULL] {
+        let (model, modes) = solve(src);
+        let rigid: Vec<_> = modes.modes.iter().filter(|m| m.frequency_hz().abs() < 1e-6).collect();
+        assert_eq!(rigid.len(), 6);
+        assert!(modes.modes[..6].iter().all(|m| m.rigid));
+        assert!(modes.modes[6].frequency_hz() > 1e-3);
+        let n = model.dof();
+        let phi = faer::Mat::from_fn(n, modes.modes.len(), |i, j| modes.modes[j].shape[i]);
+        let g = phi.transpose() * &model.mass * &phi;
+        let kk = phi.transpose() * &model.stiffness * &phi;
+        for i in 0..g.nrows() {
+            for j in 0..g.ncols() {
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((g[(i, j)] - want).abs() < 1e-10, "(ΦᵀMΦ)[{i}][{j}] = {}", g[(i, j)]);
+                let w2 = if i == j { modes.modes[i].omega_rad_s.powi(2) } else { 0.0 };
+                let scale = modes.modes[i.max(j)].omega_rad_s.powi(2).max(1.0);
+                assert!((kk[(i, j)] - w2).abs() < 1e-8 * scale, "(ΦᵀKΦ)[{i}][{j}]");
+            }
+        }
+        for m in modes.elastic() {
+            let total: f64 = m.strain_energy_share.iter().map(|s| s.1).sum();
+            assert!((total - 1.0).abs() < 1e-10);
+        }
+    }
+}
+
+/// Σ over hub-fixed modes of the effective masses = appendage rigid mass for a complete
+/// basis (Parseval in the M_ee metric); with a finite basis the sum is below it and rises as
+/// terms are added.
+#[test]
+fn effective_mass_sum_rises_towards_appendage_mass() {
+    let with_terms = |b: usize, t: usize, a: usize, pl: usize, pw: usize| {
+        SEED.replace("bending = 8, torsion = 6, axial = 4", &format!("bending = {b}, torsion = {t}, axial = {a}"))
+            .replace("length = 8, width = 6", &format!("length = {pl}, width = {pw}"))
+    };
+    let mut prev = [0.0; 6];
+    for (b, t, a, pl, pw) in [(4, 3, 2, 4, 3), (8, 6, 4, 8, 6), (16, 12, 8, 16, 12), (30, 24, 16, 24, 16)] {
+        let (_, modes) = solve(&with_terms(b, t, a, pl, pw));
+        let frac = *modes.effective_mass_fractions().last().unwrap();
+        eprintln!("terms beam ({b},{t},{a}) plate {pl}×{pw}: effective-mass fractions {frac:.6?}");
+        for d in 0..6 {
+            assert!(frac[d] <= 1.0 + 1e-10, "direction {d}: {}", frac[d]);
+            assert!(frac[d] >= prev[d] - 1e-12, "direction {d} fell: {} < {}", frac[d], prev[d]);
+        }
+        prev = frac;
+    }
+    // Rotations converge fastest; translations are limited by the axial (rod) fields.
+    assert!(prev.iter().all(|f| *f > 0.97), "{prev:?}");
+}
+
+#[test]
+fn fixed_hub_modes_equal_hub_fixed_list() {
+    let fixed = SEED.replace("motion = \"free\"", "motion = \"fixed\"");
+    let (model, modes) = solve(&fixed);
+    assert_eq!(modes.dof, model.dof() - HUB_DOF);
+    assert!(modes.modes.iter().all(|m| !m.rigid));
+    for (m, h) in modes.modes.iter().zip(&modes.hub_fixed) {
+        assert_eq!(m.omega_rad_s, h.omega_rad_s);
+        assert_eq!(m.effective_mass, Some(h.effective_mass));
+    }
+    // A free hub lowers no elastic frequency below the fixed-hub one's… in general it
+    // raises them (interlacing of constrained systems): ω_free,i ≥ ω_fixed,i.
+    let (_, free) = solve(SEED);
+    for (f, x) in free.elastic().zip(modes.modes.iter()) {
+        assert!(f.omega_rad_s >= x.omega_rad_s * (1.0 - 1e-12));
+    }
+}
