@@ -11,6 +11,8 @@
 //!
 //! SI units throughout: m, kg, s, N, Pa, rad.
 #![warn(missing_docs)]
+// Index loops over small fixed-size matrices read like the equations they implement.
+#![allow(clippy::needless_range_loop)]
 
 pub mod basis;
 pub mod math;

@@ -36,7 +36,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Modes { scenario, json, out } => run_modes(&scenario, json, out.as_deref()),
+        Command::Modes {
+            scenario,
+            json,
+            out,
+        } => run_modes(&scenario, json, out.as_deref()),
     }
 }
 

@@ -148,7 +148,9 @@ impl Mat3 {
 
     /// Matrix–vector product.
     pub fn apply(self, v: Vec3) -> Vec3 {
-        Vec3(std::array::from_fn(|i| (0..3).map(|k| self.0[i][k] * v.0[k]).sum()))
+        Vec3(std::array::from_fn(|i| {
+            (0..3).map(|k| self.0[i][k] * v.0[k]).sum()
+        }))
     }
 
     /// Trace.
@@ -200,7 +202,9 @@ impl Mat3 {
         let mut idx = [0, 1, 2];
         idx.sort_by(|&i, &j| a[i][i].total_cmp(&a[j][j]));
         let vals = [a[idx[0]][idx[0]], a[idx[1]][idx[1]], a[idx[2]][idx[2]]];
-        let vecs = Mat3(std::array::from_fn(|r| std::array::from_fn(|c| v[r][idx[c]])));
+        let vecs = Mat3(std::array::from_fn(|r| {
+            std::array::from_fn(|c| v[r][idx[c]])
+        }));
         (vals, vecs)
     }
 }
@@ -208,14 +212,18 @@ impl Mat3 {
 impl Add for Mat3 {
     type Output = Mat3;
     fn add(self, o: Mat3) -> Mat3 {
-        Mat3(std::array::from_fn(|i| std::array::from_fn(|j| self.0[i][j] + o.0[i][j])))
+        Mat3(std::array::from_fn(|i| {
+            std::array::from_fn(|j| self.0[i][j] + o.0[i][j])
+        }))
     }
 }
 
 impl Sub for Mat3 {
     type Output = Mat3;
     fn sub(self, o: Mat3) -> Mat3 {
-        Mat3(std::array::from_fn(|i| std::array::from_fn(|j| self.0[i][j] - o.0[i][j])))
+        Mat3(std::array::from_fn(|i| {
+            std::array::from_fn(|j| self.0[i][j] - o.0[i][j])
+        }))
     }
 }
 

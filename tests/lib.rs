@@ -2,10 +2,14 @@
 //! independent truth: high-precision reference data, a closed-form or transcendental solution,
 //! a published table (cited where used), a conservation law or a second formulation.
 
+#![allow(clippy::needless_range_loop)]
+
 mod suite {
     pub mod beam_functions;
+    pub mod cli;
     pub mod common;
     pub mod exact_beams;
     pub mod modal_properties;
+    pub mod mutations;
     pub mod plates;
 }

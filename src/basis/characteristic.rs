@@ -67,9 +67,7 @@ fn family(left: End, right: End) -> Family {
     match (left, right) {
         (Clamped, Free) | (Free, Clamped) => Family::ClampedFree,
         (Clamped, Clamped) | (Free, Free) => Family::CoshCosOne,
-        (Clamped, Pinned) | (Pinned, Clamped) | (Pinned, Free) | (Free, Pinned) => {
-            Family::TanTanh
-        }
+        (Clamped, Pinned) | (Pinned, Clamped) | (Pinned, Free) | (Free, Pinned) => Family::TanTanh,
         (Pinned, Pinned) => Family::SinZero,
     }
 }
@@ -91,7 +89,10 @@ pub fn root(left: End, right: End, k: usize) -> f64 {
     let (f, guess): (fn(f64) -> f64, f64) = match fam {
         Family::ClampedFree => (|b| b.cos() + 1.0 / b.cosh(), (2.0 * kf - 1.0) * PI / 2.0),
         Family::CoshCosOne => (|b| b.cos() - 1.0 / b.cosh(), (2.0 * kf + 1.0) * PI / 2.0),
-        Family::TanTanh => (|b| b.sin() - b.cos() * b.tanh(), (4.0 * kf + 1.0) * PI / 4.0),
+        Family::TanTanh => (
+            |b| b.sin() - b.cos() * b.tanh(),
+            (4.0 * kf + 1.0) * PI / 4.0,
+        ),
         Family::SinZero => return kf * PI,
     };
     // The root lies within 0.6 of the asymptotic guess for every k (closest at k = 1:
@@ -211,7 +212,8 @@ fn minor3(m: &[[f64; 4]; 4], i: usize, j: usize) -> f64 {
         }
         r += 1;
     }
-    s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1]) - s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0])
+    s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1])
+        - s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0])
         + s[0][2] * (s[1][0] * s[2][1] - s[1][1] * s[2][0])
 }
 
@@ -232,7 +234,12 @@ impl BeamFunctions {
         let elastic = (1..=n - rigid)
             .map(|k| Elastic::new(left, right, root(left, right, k)))
             .collect();
-        Self { left, right, rigid, elastic }
+        Self {
+            left,
+            right,
+            rigid,
+            elastic,
+        }
     }
 
     /// The end conditions (left at ξ = 0, right at ξ = 1).

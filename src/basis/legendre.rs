@@ -107,7 +107,12 @@ impl Basis1d for LegendreRod {
         for (k, o) in out.iter_mut().enumerate().take(self.n) {
             let c = (2.0 * k as f64 + 1.0).sqrt() / 2.0;
             let r = int_p(&p, k, t);
-            *o = [c * r, 2.0 * c * p[k][0], 4.0 * c * p[k][1], 8.0 * c * p[k][2]];
+            *o = [
+                c * r,
+                2.0 * c * p[k][0],
+                4.0 * c * p[k][1],
+                8.0 * c * p[k][2],
+            ];
         }
     }
 
@@ -139,7 +144,12 @@ impl Basis1d for LegendreFree {
         let p = legendre_table(self.n, t);
         for (k, o) in out.iter_mut().enumerate().take(self.n) {
             let c = (2.0 * k as f64 + 1.0).sqrt();
-            *o = [c * p[k][0], 2.0 * c * p[k][1], 4.0 * c * p[k][2], 8.0 * c * p[k][3]];
+            *o = [
+                c * p[k][0],
+                2.0 * c * p[k][1],
+                4.0 * c * p[k][2],
+                8.0 * c * p[k][3],
+            ];
         }
     }
 

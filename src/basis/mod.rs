@@ -98,7 +98,9 @@ pub trait Basis1d: std::fmt::Debug + Send + Sync {
     fn quadrature(&self) -> Quadrature {
         match self.polynomial_degree() {
             Some(d) => Quadrature::gauss(d + 2),
-            None => Quadrature::composite(((self.max_wavenumber() / 3.0).ceil() as usize).max(4), 12),
+            None => {
+                Quadrature::composite(((self.max_wavenumber() / 3.0).ceil() as usize).max(4), 12)
+            }
         }
     }
 }
@@ -147,6 +149,13 @@ impl Integrals {
                 }
             }
         }
-        Self { i00, i11, i22, i20, m0, m1 }
+        Self {
+            i00,
+            i11,
+            i22,
+            i20,
+            m0,
+            m1,
+        }
     }
 }

@@ -68,7 +68,11 @@ impl Quadrature {
 
     /// ∫₀¹ f(ξ) dξ by this rule.
     pub fn integrate(&self, f: impl Fn(f64) -> f64) -> f64 {
-        self.points.iter().zip(&self.weights).map(|(&x, &w)| w * f(x)).sum()
+        self.points
+            .iter()
+            .zip(&self.weights)
+            .map(|(&x, &w)| w * f(x))
+            .sum()
     }
 
     /// Number of nodes.

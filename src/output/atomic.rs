@@ -20,14 +20,21 @@ impl OutputDir {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        let name = target.file_name().map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
+        let name = target
+            .file_name()
+            .map_or_else(|| "out".into(), |n| n.to_string_lossy().into_owned());
         std::fs::create_dir_all(&parent)?;
         let staging = parent.join(format!(".{name}.partial-{}", std::process::id()));
         if staging.exists() {
             std::fs::remove_dir_all(&staging)?;
         }
         std::fs::create_dir_all(&staging)?;
-        Ok(Self { target: target.to_path_buf(), staging, files: Vec::new(), committed: false })
+        Ok(Self {
+            target: target.to_path_buf(),
+            staging,
+            files: Vec::new(),
+            committed: false,
+        })
     }
 
     /// The staging path for a relative file name (parent folders created); record it.

@@ -96,7 +96,11 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
         .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
         .map(|e| st.component_name(e.id).to_string())
         .collect();
-    let _ = write!(s, "\n{:>4}  {:<7} {:>12} {:>12}  {:<10}", "mode", "kind", "f [Hz]", "ω [rad/s]", "dominant");
+    let _ = write!(
+        s,
+        "\n{:>4}  {:<7} {:>12} {:>12}  {:<10}",
+        "mode", "kind", "f [Hz]", "ω [rad/s]", "dominant"
+    );
     for n in &names {
         let _ = write!(s, " {:>8}", format!("SE {n}"));
     }
@@ -112,7 +116,11 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
             m.dominant()
         );
         for n in &names {
-            let v = m.strain_energy_share.iter().find(|(k, _)| k == n).map(|x| x.1);
+            let v = m
+                .strain_energy_share
+                .iter()
+                .find(|(k, _)| k == n)
+                .map(|x| x.1);
             match v {
                 Some(v) => {
                     let _ = write!(s, " {:>8.4}", v);
@@ -140,7 +148,12 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
     }
     s.push('\n');
     for (i, (m, f)) in modes.hub_fixed.iter().zip(&fr).enumerate() {
-        let _ = write!(s, "{:>4} {:>12.6}", i + 1, m.omega_rad_s / (2.0 * std::f64::consts::PI));
+        let _ = write!(
+            s,
+            "{:>4} {:>12.6}",
+            i + 1,
+            m.omega_rad_s / (2.0 * std::f64::consts::PI)
+        );
         for v in m.effective_mass {
             let _ = write!(s, " {:>10.4e}", v);
         }
@@ -157,7 +170,10 @@ fn csv_num(v: f64) -> String {
 }
 
 /// Samples of every elastic component for generalized coordinates q.
-pub(crate) fn sample_all(model: &RitzModel, q: &[f64]) -> Vec<(String, ComponentId, Vec<PointSample>)> {
+pub(crate) fn sample_all(
+    model: &RitzModel,
+    q: &[f64],
+) -> Vec<(String, ComponentId, Vec<PointSample>)> {
     let st = &model.structure;
     let mut out = Vec::new();
     for e in &model.elements {
@@ -173,7 +189,11 @@ pub(crate) fn sample_all(model: &RitzModel, q: &[f64]) -> Vec<(String, Component
 
 /// Writes modes.json, frequencies.csv, coefficients/mode_NNN.csv, shapes/mode_NNN.csv and
 /// plots/mode_NNN.{png,svg} (first 12 modes).
-pub fn write_modes(dir: &mut OutputDir, model: &RitzModel, modes: &ModalAnalysis) -> Result<(), OutputError> {
+pub fn write_modes(
+    dir: &mut OutputDir,
+    model: &RitzModel,
+    modes: &ModalAnalysis,
+) -> Result<(), OutputError> {
     let st = &model.structure;
     dir.write("modes.json", modes_json(model, modes) + "\n")?;
 
@@ -193,9 +213,21 @@ pub fn write_modes(dir: &mut OutputDir, model: &RitzModel, modes: &ModalAnalysis
     }
     f.push('\n');
     for m in &modes.modes {
-        let _ = write!(f, "{},{},{},{},{}", m.number, m.rigid, csv_num(m.frequency_hz()), csv_num(m.omega_rad_s), m.dominant());
+        let _ = write!(
+            f,
+            "{},{},{},{},{}",
+            m.number,
+            m.rigid,
+            csv_num(m.frequency_hz()),
+            csv_num(m.omega_rad_s),
+            m.dominant()
+        );
         for n in &names {
-            let v = m.strain_energy_share.iter().find(|(k, _)| k == n).map_or(0.0, |x| x.1);
+            let v = m
+                .strain_energy_share
+                .iter()
+                .find(|(k, _)| k == n)
+                .map_or(0.0, |x| x.1);
             let _ = write!(f, ",{}", csv_num(v));
         }
         for d in 0..6 {
@@ -227,10 +259,13 @@ pub fn write_modes(dir: &mut OutputDir, model: &RitzModel, modes: &ModalAnalysis
             for fr in &e.fields {
                 for k in 0..fr.len {
                     let v = csv_num(m.shape[fr.start + k]);
-                    if ny > 0 {
-                        let _ = writeln!(c, "{name},{},{},{},{v}", fr.field, k / ny + 1, k % ny + 1);
-                    } else {
-                        let _ = writeln!(c, "{name},{},{},,{v}", fr.field, k + 1);
+                    match (k.checked_div(ny), k.checked_rem(ny)) {
+                        (Some(i), Some(j)) => {
+                            let _ = writeln!(c, "{name},{},{},{},{v}", fr.field, i + 1, j + 1);
+                        }
+                        _ => {
+                            let _ = writeln!(c, "{name},{},{},,{v}", fr.field, k + 1);
+                        }
                     }
                 }
             }

@@ -25,14 +25,23 @@ fn polylines(model: &RitzModel, q: &[f64]) -> (Lines, Lines) {
     let mut undeformed = Vec::new();
     let mut deformed = Vec::new();
     let samples = super::modes::sample_all(model, q);
-    let max_disp = samples.iter().flat_map(|(_, _, s)| s.iter().map(|p| p.displacement.norm())).fold(0.0, f64::max);
+    let max_disp = samples
+        .iter()
+        .flat_map(|(_, _, s)| s.iter().map(|p| p.displacement.norm()))
+        .fold(0.0, f64::max);
     let extent = samples
         .iter()
         .flat_map(|(_, _, s)| s.iter().map(|p| p.position.norm()))
         .fold(1.0, f64::max);
-    let scale = if max_disp > 0.0 { 0.12 * extent / max_disp } else { 0.0 };
+    let scale = if max_disp > 0.0 {
+        0.12 * extent / max_disp
+    } else {
+        0.0
+    };
     for (_, id, s) in &samples {
-        let pos = |p: &crate::ritz::shapes::PointSample| (p.position.0[0], p.position.0[1], p.position.0[2]);
+        let pos = |p: &crate::ritz::shapes::PointSample| {
+            (p.position.0[0], p.position.0[1], p.position.0[2])
+        };
         let def = |p: &crate::ritz::shapes::PointSample| {
             let r = p.position + p.displacement * scale;
             (r.0[0], r.0[1], r.0[2])
@@ -84,7 +93,10 @@ fn draw_view<DB: DrawingBackend>(
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(48)
-        .build_cartesian_2d(cx - span / 2.0..cx + span / 2.0, cy - span / 2.0..cy + span / 2.0)
+        .build_cartesian_2d(
+            cx - span / 2.0..cx + span / 2.0,
+            cy - span / 2.0..cy + span / 2.0,
+        )
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
@@ -95,26 +107,57 @@ fn draw_view<DB: DrawingBackend>(
         .map_err(|e| e.to_string())?;
     for l in und {
         chart
-            .draw_series(LineSeries::new(l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))), RGBColor(170, 170, 170)))
+            .draw_series(LineSeries::new(
+                l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))),
+                RGBColor(170, 170, 170),
+            ))
             .map_err(|e| e.to_string())?;
     }
     for l in def {
         chart
-            .draw_series(LineSeries::new(l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))), RGBColor(20, 90, 200).stroke_width(2)))
+            .draw_series(LineSeries::new(
+                l.iter().map(|p| (pick(p, axes.0), pick(p, axes.1))),
+                RGBColor(20, 90, 200).stroke_width(2),
+            ))
             .map_err(|e| e.to_string())?;
     }
     Ok(())
 }
 
-fn draw_mode<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, model: &RitzModel, mode: &Mode) -> Result<(), String> {
+fn draw_mode<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    model: &RitzModel,
+    mode: &Mode,
+) -> Result<(), String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let kind = if mode.rigid { "rigid" } else { "elastic" };
-    let title = format!("mode {} ({kind}), f = {:.6} Hz, dominant: {}", mode.number, mode.frequency_hz(), mode.dominant());
-    let root = root.titled(&title, ("sans-serif", 22)).map_err(|e| e.to_string())?;
+    let title = format!(
+        "mode {} ({kind}), f = {:.6} Hz, dominant: {}",
+        mode.number,
+        mode.frequency_hz(),
+        mode.dominant()
+    );
+    let root = root
+        .titled(&title, ("sans-serif", 22))
+        .map_err(|e| e.to_string())?;
     let (und, def) = polylines(model, &mode.shape);
     let (a, b) = root.split_horizontally(root.dim_in_pixel().0 / 2);
-    draw_view(&a, "side view (x–z), grey: undeformed", (0, 2), ("x [m]", "z [m]"), &und, &def)?;
-    draw_view(&b, "top view (x–y), blue: deformed (exaggerated)", (0, 1), ("x [m]", "y [m]"), &und, &def)?;
+    draw_view(
+        &a,
+        "side view (x–z), grey: undeformed",
+        (0, 2),
+        ("x [m]", "z [m]"),
+        &und,
+        &def,
+    )?;
+    draw_view(
+        &b,
+        "top view (x–y), blue: deformed (exaggerated)",
+        (0, 1),
+        ("x [m]", "y [m]"),
+        &und,
+        &def,
+    )?;
     root.present().map_err(|e| e.to_string())
 }
 
@@ -127,9 +170,17 @@ pub fn mode_shape(dir: &mut OutputDir, model: &RitzModel, mode: &Mode) -> Result
         let path = dir.path(&rel)?;
         let size = (1200, 640);
         let r = if ext == "png" {
-            draw_mode(BitMapBackend::new(&path, size).into_drawing_area(), model, mode)
+            draw_mode(
+                BitMapBackend::new(&path, size).into_drawing_area(),
+                model,
+                mode,
+            )
         } else {
-            draw_mode(SVGBackend::new(&path, size).into_drawing_area(), model, mode)
+            draw_mode(
+                SVGBackend::new(&path, size).into_drawing_area(),
+                model,
+                mode,
+            )
         };
         r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
     }

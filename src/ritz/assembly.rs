@@ -107,18 +107,38 @@ impl RitzModel {
         for &i in structure.beam_order() {
             let t = structure.beams[i].terms;
             let mut fields = Vec::new();
-            for (field, len) in [("u", t.axial), ("v", t.bending), ("w", t.bending), ("theta", t.torsion)] {
-                fields.push(FieldRange { field, start: n, len });
+            for (field, len) in [
+                ("u", t.axial),
+                ("v", t.bending),
+                ("w", t.bending),
+                ("theta", t.torsion),
+            ] {
+                fields.push(FieldRange {
+                    field,
+                    start: n,
+                    len,
+                });
                 n += len;
             }
-            let basis = ElementBasis::Beam { axial: kind.rod(t.axial), bending: kind.bending(t.bending), torsion: kind.rod(t.torsion) };
+            let basis = ElementBasis::Beam {
+                axial: kind.rod(t.axial),
+                bending: kind.bending(t.bending),
+                torsion: kind.rod(t.torsion),
+            };
             layout.push((ComponentId::Beam(i), fields, basis));
         }
         for (i, p) in structure.plates.iter().enumerate() {
             let len = p.terms.dof();
-            let fields = vec![FieldRange { field: "g", start: n, len }];
+            let fields = vec![FieldRange {
+                field: "g",
+                start: n,
+                len,
+            }];
             n += len;
-            let basis = ElementBasis::Plate { length: kind.bending(p.terms.length), width: kind.free_free(p.terms.width) };
+            let basis = ElementBasis::Plate {
+                length: kind.bending(p.terms.length),
+                width: kind.free_free(p.terms.width),
+            };
             layout.push((ComponentId::Plate(i), fields, basis));
         }
         for i in 0..structure.masses.len() {
@@ -158,23 +178,49 @@ impl RitzModel {
             };
             let own = fields.first().map_or(0, |f| f.start);
             match (&id, &basis) {
-                (ComponentId::Beam(i), ElementBasis::Beam { axial, bending, torsion }) => {
-                    let (me, ke) = beam_element(&structure.beams[*i], axial.as_ref(), bending.as_ref(), torsion.as_ref());
+                (
+                    ComponentId::Beam(i),
+                    ElementBasis::Beam {
+                        axial,
+                        bending,
+                        torsion,
+                    },
+                ) => {
+                    let (me, ke) = beam_element(
+                        &structure.beams[*i],
+                        axial.as_ref(),
+                        bending.as_ref(),
+                        torsion.as_ref(),
+                    );
                     add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
                     beam_elem[*i] = Some(elements.len());
                 }
                 (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
-                    let (me, ke) = plate_element(&structure.plates[*i], length.as_ref(), width.as_ref());
+                    let (me, ke) =
+                        plate_element(&structure.plates[*i], length.as_ref(), width.as_ref());
                     add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
                 }
-                (ComponentId::Mass(i), _) => add_rigid(&mut mass, &t, &structure.masses[*i].rigid_body()),
+                (ComponentId::Mass(i), _) => {
+                    add_rigid(&mut mass, &t, &structure.masses[*i].rigid_body())
+                }
                 _ => unreachable!("layout pairs ids with their bases"),
             }
-            elements.push(Element { id, fields, attachment: t, origin, basis });
+            elements.push(Element {
+                id,
+                fields,
+                attachment: t,
+                origin,
+                basis,
+            });
         }
         symmetrize(&mut mass);
         symmetrize(&mut stiffness);
-        Self { structure: structure.clone(), mass, stiffness, elements }
+        Self {
+            structure: structure.clone(),
+            mass,
+            stiffness,
+            elements,
+        }
     }
 
     /// The element of a component.
@@ -211,7 +257,12 @@ fn hub_map(n: usize, p: Vec3, c_hub: Vec3) -> Mat<f64> {
 /// T of the section at `station` of a beam: translation
 /// U + Θ × s e_x + u(s) e_x + v(s) e_y + w(s) e_z, rotation Θ + θ(s) e_x − w'(s) e_y + v'(s) e_z.
 fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64> {
-    let ElementBasis::Beam { axial, bending, torsion } = &parent.basis else {
+    let ElementBasis::Beam {
+        axial,
+        bending,
+        torsion,
+    } = &parent.basis
+    else {
         unreachable!("a beam element has a beam basis")
     };
     let f = beam.frame;
@@ -275,14 +326,23 @@ fn set_coupling(me: &mut Mat<f64>, col: usize, du: Vec3, dth: Vec3) {
 /// Beam element (MODEL.md §3.1):
 /// T = ½∫ρA|U̇ + Θ̇ × x e_x + u̇ e_x + v̇ e_y + ẇ e_z|² + ρI_p(Θ̇·e_x + θ̇)² dx,
 /// U = ½∫(EA u'² + EI_z v''² + EI_y w''² + GJ θ'²) dx.
-pub(crate) fn beam_element(beam: &Beam, axial: &dyn Basis1d, bending: &dyn Basis1d, torsion: &dyn Basis1d) -> (Mat<f64>, Mat<f64>) {
+pub(crate) fn beam_element(
+    beam: &Beam,
+    axial: &dyn Basis1d,
+    bending: &dyn Basis1d,
+    torsion: &dyn Basis1d,
+) -> (Mat<f64>, Mat<f64>) {
     let (na, nb, nt) = (axial.len(), bending.len(), torsion.len());
     let ne = na + 2 * nb + nt;
     let l = beam.length;
     let rho_a = beam.mass_per_length();
     let rho_ip = beam.density * beam.section.polar_inertia;
     let f = beam.frame;
-    let (ia, ib, it) = (Integrals::new(axial), Integrals::new(bending), Integrals::new(torsion));
+    let (ia, ib, it) = (
+        Integrals::new(axial),
+        Integrals::new(bending),
+        Integrals::new(torsion),
+    );
     let mut me = rigid_block(&beam.rigid_body(), ne);
     let mut ke = Mat::zeros(ne, ne);
     let (ou, ov, ow, ot) = (6, 6 + na, 6 + na + nb, 6 + na + 2 * nb);
@@ -290,8 +350,18 @@ pub(crate) fn beam_element(beam: &Beam, axial: &dyn Basis1d, bending: &dyn Basis
         set_coupling(&mut me, ou + i, f.ex * (rho_a * l * ia.m0[i]), Vec3::ZERO);
     }
     for j in 0..nb {
-        set_coupling(&mut me, ov + j, f.ey * (rho_a * l * ib.m0[j]), f.ez * (rho_a * l * l * ib.m1[j]));
-        set_coupling(&mut me, ow + j, f.ez * (rho_a * l * ib.m0[j]), f.ey * (-rho_a * l * l * ib.m1[j]));
+        set_coupling(
+            &mut me,
+            ov + j,
+            f.ey * (rho_a * l * ib.m0[j]),
+            f.ez * (rho_a * l * l * ib.m1[j]),
+        );
+        set_coupling(
+            &mut me,
+            ow + j,
+            f.ez * (rho_a * l * ib.m0[j]),
+            f.ey * (-rho_a * l * l * ib.m1[j]),
+        );
     }
     for k in 0..nt {
         set_coupling(&mut me, ot + k, Vec3::ZERO, f.ex * (rho_ip * l * it.m0[k]));
@@ -316,7 +386,8 @@ pub(crate) fn beam_element(beam: &Beam, axial: &dyn Basis1d, bending: &dyn Basis
     for i in 0..nt {
         for j in 0..nt {
             me[(ot + i, ot + j)] = rho_ip * l * it.i00[(i, j)];
-            ke[(ot + i - 6, ot + j - 6)] = beam.shear_modulus * s.torsion_constant / l * it.i11[(i, j)];
+            ke[(ot + i - 6, ot + j - 6)] =
+                beam.shear_modulus * s.torsion_constant / l * it.i11[(i, j)];
         }
     }
     (me, ke)
@@ -326,7 +397,11 @@ pub(crate) fn beam_element(beam: &Beam, axial: &dyn Basis1d, bending: &dyn Basis
 /// T = ½∫μ|U̇ + Θ̇ × r + Ẇ n|² dA,
 /// U = (D/2)∫[W_xx² + W_yy² + 2ν W_xx W_yy + 2(1 − ν) W_xy²] dA
 /// (= (D/2)∫[(ΔW)² − 2(1−ν)(W_xx W_yy − W_xy²)] dA).
-pub(crate) fn plate_element(plate: &Plate, xb: &dyn Basis1d, yb: &dyn Basis1d) -> (Mat<f64>, Mat<f64>) {
+pub(crate) fn plate_element(
+    plate: &Plate,
+    xb: &dyn Basis1d,
+    yb: &dyn Basis1d,
+) -> (Mat<f64>, Mat<f64>) {
     let (nx, ny) = (xb.len(), yb.len());
     let ne = nx * ny;
     let (a, b) = (plate.length, plate.width);
@@ -342,7 +417,12 @@ pub(crate) fn plate_element(plate: &Plate, xb: &dyn Basis1d, yb: &dyn Basis1d) -
             let k = m * ny + n;
             let mean_x = a * ix.m1[m] * iy.m0[n];
             let mean_y = ix.m0[m] * b * (iy.m1[n] - 0.5 * iy.m0[n]);
-            set_coupling(&mut me, 6 + k, nn * (mu * area * ix.m0[m] * iy.m0[n]), (eb * -mean_x + ea * mean_y) * (mu * area));
+            set_coupling(
+                &mut me,
+                6 + k,
+                nn * (mu * area * ix.m0[m] * iy.m0[n]),
+                (eb * -mean_x + ea * mean_y) * (mu * area),
+            );
         }
     }
     let (a2b2, a4, b4) = (a * a * b * b, a.powi(4), b.powi(4));
@@ -354,7 +434,9 @@ pub(crate) fn plate_element(plate: &Plate, xb: &dyn Basis1d, yb: &dyn Basis1d) -
                     me[(6 + k, 6 + l)] = mu * area * ix.i00[(m, p)] * iy.i00[(n, q)];
                     let kxx = ix.i22[(m, p)] * iy.i00[(n, q)] / a4;
                     let kyy = ix.i00[(m, p)] * iy.i22[(n, q)] / b4;
-                    let kxy = nu * (ix.i20[(m, p)] * iy.i20[(q, n)] + ix.i20[(p, m)] * iy.i20[(n, q)]) / a2b2;
+                    let kxy = nu
+                        * (ix.i20[(m, p)] * iy.i20[(q, n)] + ix.i20[(p, m)] * iy.i20[(n, q)])
+                        / a2b2;
                     let ktw = 2.0 * (1.0 - nu) * ix.i11[(m, p)] * iy.i11[(n, q)] / a2b2;
                     ke[(k, l)] = d * area * (kxx + kyy + kxy + ktw);
                 }
@@ -381,7 +463,14 @@ fn add_into(dst: &mut Mat<f64>, r0: usize, c0: usize, src: &Mat<f64>) {
 }
 
 /// M += Bᵀ M_e B and K[own, own] += K_e with B = [T; P_own].
-fn add_element(mass: &mut Mat<f64>, stiffness: &mut Mat<f64>, t: &Mat<f64>, own: usize, me: &Mat<f64>, ke: &Mat<f64>) {
+fn add_element(
+    mass: &mut Mat<f64>,
+    stiffness: &mut Mat<f64>,
+    t: &Mat<f64>,
+    own: usize,
+    me: &Mat<f64>,
+    ke: &Mat<f64>,
+) {
     let ne = ke.nrows();
     let mrr = me.submatrix(0, 0, 6, 6).to_owned();
     let mro = me.submatrix(0, 6, 6, ne).to_owned();

@@ -13,7 +13,10 @@ use faer::{Mat, Side};
 /// the Rayleigh quotient's error is quadratic in the eigenvector's.
 ///
 /// Returns λ ascending and Φ with ΦᵀMΦ = I.
-pub fn generalized_symmetric(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
+pub fn generalized_symmetric(
+    k: &Mat<f64>,
+    m: &Mat<f64>,
+) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
     let n = m.nrows();
     if n == 0 {
         return Ok((Vec::new(), Mat::zeros(0, 0)));
@@ -39,7 +42,9 @@ pub fn generalized_symmetric(k: &Mat<f64>, m: &Mat<f64>) -> Result<(Vec<f64>, Ma
         Err(_) => {
             let llt = ms
                 .llt(Side::Lower)
-                .map_err(|_| RitzError::MassNotPositiveDefinite { pivot: first_bad_pivot(&ms) })?;
+                .map_err(|_| RitzError::MassNotPositiveDefinite {
+                    pivot: first_bad_pivot(&ms),
+                })?;
             symmetric_reduced(llt.L(), &ks)?
         }
     };
@@ -80,7 +85,9 @@ fn symmetric_reduced(l: faer::MatRef<'_, f64>, a: &Mat<f64>) -> Result<Mat<f64>,
     l.solve_lower_triangular_in_place(c.as_mut());
     let n = c.nrows();
     let c = Mat::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|_| RitzError::EigenNoConvergence)?;
+    let evd = c
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|_| RitzError::EigenNoConvergence)?;
     let mut phi = evd.U().to_owned();
     l.transpose().solve_upper_triangular_in_place(phi.as_mut());
     Ok(phi)
@@ -92,7 +99,7 @@ fn first_bad_pivot(m: &Mat<f64>) -> usize {
     let mut a = m.clone();
     for k in 0..n {
         let p = a[(k, k)];
-        if !(p > 0.0) {
+        if p.is_nan() || p <= 0.0 {
             return k;
         }
         for i in k + 1..n {

@@ -98,7 +98,10 @@ impl ModalAnalysis {
                     let l: f64 = (0..ne).map(|i| phi_f[(i, j)] * mer[(i, d)]).sum();
                     *e = l * l;
                 }
-                HubFixedMode { omega_rad_s: lam_f[j].max(0.0).sqrt(), effective_mass: eff }
+                HubFixedMode {
+                    omega_rad_s: lam_f[j].max(0.0).sqrt(),
+                    effective_mass: eff,
+                }
             })
             .collect();
         let appendage_mass = appendage_mass(model, &mrr);
@@ -112,17 +115,26 @@ impl ModalAnalysis {
                     for i in 0..ne {
                         shape[HUB_DOF + i] = phi_f[(i, j)];
                     }
-                    modes.push(elastic_mode(model, lam_f[j], shape, Some(hub_fixed[j].effective_mass)));
+                    modes.push(elastic_mode(
+                        model,
+                        lam_f[j],
+                        shape,
+                        Some(hub_fixed[j].effective_mass),
+                    ));
                 }
             }
             HubMotion::Free => {
                 modes.extend(rigid_modes(model, &mrr));
                 // M̃ = M_ee − M_er M_rr⁻¹ M_re.
-                let llt = mrr.llt(Side::Lower).map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
+                let llt = mrr
+                    .llt(Side::Lower)
+                    .map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
                 let mut x = mer.transpose().to_owned(); // 6 × ne → M_rr⁻¹ M_re
                 faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
                 let corr = &mer * &x;
-                let mt = Mat::from_fn(ne, ne, |i, j| mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)]));
+                let mt = Mat::from_fn(ne, ne, |i, j| {
+                    mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)])
+                });
                 let (lam, phi) = generalized_symmetric(&kee, &mt)?;
                 for j in 0..ne {
                     let mut shape = vec![0.0; n];
@@ -143,7 +155,13 @@ impl ModalAnalysis {
             HubMotion::Free => n,
             HubMotion::Fixed => ne,
         };
-        Ok(Self { dof, hub_motion: motion, modes, hub_fixed, appendage_mass })
+        Ok(Self {
+            dof,
+            hub_motion: motion,
+            modes,
+            hub_fixed,
+            appendage_mass,
+        })
     }
 
     /// Elastic modes only.
@@ -161,7 +179,13 @@ impl ModalAnalysis {
                 for d in 0..6 {
                     run[d] += m.effective_mass[d];
                 }
-                std::array::from_fn(|d| if self.appendage_mass[d] > 0.0 { run[d] / self.appendage_mass[d] } else { 0.0 })
+                std::array::from_fn(|d| {
+                    if self.appendage_mass[d] > 0.0 {
+                        run[d] / self.appendage_mass[d]
+                    } else {
+                        0.0
+                    }
+                })
             })
             .collect()
     }
@@ -169,7 +193,13 @@ impl ModalAnalysis {
 
 /// Sign convention: the largest-magnitude coordinate is positive (deterministic output).
 fn fix_sign(shape: &mut [f64]) {
-    let big = shape.iter().copied().fold(0.0f64, |acc, v| if v.abs() > acc.abs() * (1.0 + 1e-9) { v } else { acc });
+    let big = shape.iter().copied().fold(0.0f64, |acc, v| {
+        if v.abs() > acc.abs() * (1.0 + 1e-9) {
+            v
+        } else {
+            acc
+        }
+    });
     if big < 0.0 {
         for v in shape.iter_mut() {
             *v = -*v;
@@ -177,7 +207,12 @@ fn fix_sign(shape: &mut [f64]) {
     }
 }
 
-fn elastic_mode(model: &RitzModel, lambda: f64, mut shape: Vec<f64>, eff: Option<[f64; 6]>) -> Mode {
+fn elastic_mode(
+    model: &RitzModel,
+    lambda: f64,
+    mut shape: Vec<f64>,
+    eff: Option<[f64; 6]>,
+) -> Mode {
     fix_sign(&mut shape);
     let k = &model.stiffness;
     let mut shares = Vec::new();
@@ -198,7 +233,14 @@ fn elastic_mode(model: &RitzModel, lambda: f64, mut shape: Vec<f64>, eff: Option
     for s in &mut shares {
         s.1 = if total > 0.0 { s.1 / total } else { 0.0 };
     }
-    Mode { number: 0, rigid: false, omega_rad_s: lambda.max(0.0).sqrt(), shape, strain_energy_share: shares, effective_mass: eff }
+    Mode {
+        number: 0,
+        rigid: false,
+        omega_rad_s: lambda.max(0.0).sqrt(),
+        shape,
+        strain_energy_share: shares,
+        effective_mass: eff,
+    }
 }
 
 /// The six exact rigid-body modes of the free structure.
@@ -208,14 +250,27 @@ fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
     // M_rr = [[mI, −S(s)], [S(s), J]] about the hub's CM; s = m d.
     let s = Vec3::new(mrr[(5, 1)], mrr[(3, 2)], mrr[(4, 0)]);
     let d = s * (1.0 / mass);
-    let j = crate::math::Mat3(std::array::from_fn(|a| std::array::from_fn(|b| mrr[(3 + a, 3 + b)])));
-    let rb = RigidBody { mass, first_moment: s, inertia: j };
+    let j = crate::math::Mat3(std::array::from_fn(|a| {
+        std::array::from_fn(|b| mrr[(3 + a, 3 + b)])
+    }));
+    let rb = RigidBody {
+        mass,
+        first_moment: s,
+        inertia: j,
+    };
     let (principal, axes) = rb.inertia_at_cm().symmetric_eigen();
     let mut out = Vec::new();
     for a in 0..3 {
         let mut shape = vec![0.0; n];
         shape[a] = 1.0 / mass.sqrt();
-        out.push(Mode { number: 0, rigid: true, omega_rad_s: 0.0, shape, strain_energy_share: Vec::new(), effective_mass: None });
+        out.push(Mode {
+            number: 0,
+            rigid: true,
+            omega_rad_s: 0.0,
+            shape,
+            strain_energy_share: Vec::new(),
+            effective_mass: None,
+        });
     }
     for (a, &ia) in principal.iter().enumerate() {
         let axis = Vec3::new(axes.get(0, a), axes.get(1, a), axes.get(2, a));
@@ -228,7 +283,14 @@ fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
             shape[3 + i] = th.get(i);
         }
         fix_sign(&mut shape);
-        out.push(Mode { number: 0, rigid: true, omega_rad_s: 0.0, shape, strain_energy_share: Vec::new(), effective_mass: None });
+        out.push(Mode {
+            number: 0,
+            rigid: true,
+            omega_rad_s: 0.0,
+            shape,
+            strain_energy_share: Vec::new(),
+            effective_mass: None,
+        });
     }
     let _ = n;
     out

@@ -29,8 +29,17 @@ fn attachment_motion(e: &Element, q: &[f64]) -> (Vec3, Vec3) {
 
 /// Samples a beam at `n` equally spaced stations (root and tip included).
 pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<PointSample> {
-    let Some(e) = model.element(ComponentId::Beam(beam)) else { return Vec::new() };
-    let ElementBasis::Beam { axial, bending, torsion } = &e.basis else { return Vec::new() };
+    let Some(e) = model.element(ComponentId::Beam(beam)) else {
+        return Vec::new();
+    };
+    let ElementBasis::Beam {
+        axial,
+        bending,
+        torsion,
+    } = &e.basis
+    else {
+        return Vec::new();
+    };
     let b = &model.structure.beams[beam];
     let f = b.frame;
     let (u0, th0) = attachment_motion(e, q);
@@ -40,7 +49,12 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
             let xi = i as f64 / (n.max(2) - 1) as f64;
             let x = xi * b.length;
             let sum = |basis: &dyn crate::basis::Basis1d, c: &[f64], d: usize| -> f64 {
-                basis.eval_vec(xi).iter().zip(c).map(|(v, ci)| v[d] * ci).sum()
+                basis
+                    .eval_vec(xi)
+                    .iter()
+                    .zip(c)
+                    .map(|(v, ci)| v[d] * ci)
+                    .sum()
             };
             let u = sum(axial.as_ref(), coeff(0), 0);
             let v = sum(bending.as_ref(), coeff(1), 0);
@@ -60,16 +74,28 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
 }
 
 /// Samples a plate on an `nx` × `ny` grid (edges included), row-major in x.
-pub fn sample_plate(model: &RitzModel, plate: usize, q: &[f64], nx: usize, ny: usize) -> Vec<PointSample> {
-    let Some(e) = model.element(ComponentId::Plate(plate)) else { return Vec::new() };
-    let ElementBasis::Plate { length, width } = &e.basis else { return Vec::new() };
+pub fn sample_plate(
+    model: &RitzModel,
+    plate: usize,
+    q: &[f64],
+    nx: usize,
+    ny: usize,
+) -> Vec<PointSample> {
+    let Some(e) = model.element(ComponentId::Plate(plate)) else {
+        return Vec::new();
+    };
+    let ElementBasis::Plate { length, width } = &e.basis else {
+        return Vec::new();
+    };
     let p = &model.structure.plates[plate];
     let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
     let (u0, th0) = attachment_motion(e, q);
     let g = &q[e.fields[0].start..e.fields[0].start + e.fields[0].len];
     let nyb = width.len();
     let mut out = Vec::with_capacity(nx * ny);
-    let yv: Vec<Vec<[f64; 4]>> = (0..ny).map(|j| width.eval_vec(j as f64 / (ny.max(2) - 1) as f64)).collect();
+    let yv: Vec<Vec<[f64; 4]>> = (0..ny)
+        .map(|j| width.eval_vec(j as f64 / (ny.max(2) - 1) as f64))
+        .collect();
     for i in 0..nx {
         let xi = i as f64 / (nx.max(2) - 1) as f64;
         let xv = length.eval_vec(xi);
@@ -89,7 +115,12 @@ pub fn sample_plate(model: &RitzModel, plate: usize, q: &[f64], nx: usize, ny: u
             let r = ea * x + eb * y;
             // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
             let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
-            out.push(PointSample { local: [x, y], position: e.origin + r, displacement: u0 + th0.cross(r) + nn * w, rotation: rot });
+            out.push(PointSample {
+                local: [x, y],
+                position: e.origin + r,
+                displacement: u0 + th0.cross(r) + nn * w,
+                rotation: rot,
+            });
         }
     }
     out

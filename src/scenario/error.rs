@@ -35,13 +35,15 @@ impl Location {
         let before = &src[..o];
         let line = before.matches('\n').count() + 1;
         let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        Self { line, column: src[line_start..o].chars().count() + 1 }
+        Self {
+            line,
+            column: src[line_start..o].chars().count() + 1,
+        }
     }
 }
 
 /// A scenario refused, with where and why.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("{file}:{}:{}: {key}: {reason}", location.line, location.column)]
 pub struct ScenarioError {
     /// Kind of problem.
     pub kind: ErrorKind,
@@ -53,4 +55,23 @@ pub struct ScenarioError {
     pub key: String,
     /// Why it is refused.
     pub reason: String,
+}
+
+impl std::fmt::Display for ScenarioError {
+    /// `file:line:column: key: reason`, or `file: reason` when the file could not be read.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.kind == ErrorKind::Io {
+            write!(
+                f,
+                "{}: cannot read the scenario: {}",
+                self.file, self.reason
+            )
+        } else {
+            write!(
+                f,
+                "{}:{}:{}: {}: {}",
+                self.file, self.location.line, self.location.column, self.key, self.reason
+            )
+        }
+    }
 }

@@ -9,8 +9,8 @@ pub use error::{ErrorKind, Location, ScenarioError};
 
 use crate::math::Vec3;
 use crate::structure::{
-    inertia_tensor, Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass, Material, Plate,
-    PlateTerms, Structure, StructureError,
+    inertia_tensor, Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass,
+    Material, Plate, PlateTerms, Structure, StructureError,
 };
 use raw::*;
 use std::collections::BTreeMap;
@@ -36,7 +36,13 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn err(&self, kind: ErrorKind, span: Range<usize>, key: impl Into<String>, reason: impl Into<String>) -> ScenarioError {
+    fn err(
+        &self,
+        kind: ErrorKind,
+        span: Range<usize>,
+        key: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> ScenarioError {
         ScenarioError {
             kind,
             file: self.file.to_string(),
@@ -46,11 +52,21 @@ impl Ctx<'_> {
         }
     }
 
-    fn invalid(&self, span: Range<usize>, key: impl Into<String>, reason: impl Into<String>) -> ScenarioError {
+    fn invalid(
+        &self,
+        span: Range<usize>,
+        key: impl Into<String>,
+        reason: impl Into<String>,
+    ) -> ScenarioError {
         self.err(ErrorKind::Invalid, span, key, reason)
     }
 
-    fn structural<T>(&self, r: Result<T, StructureError>, span: Range<usize>, key: impl Into<String>) -> Result<T, ScenarioError> {
+    fn structural<T>(
+        &self,
+        r: Result<T, StructureError>,
+        span: Range<usize>,
+        key: impl Into<String>,
+    ) -> Result<T, ScenarioError> {
         r.map_err(|e| self.invalid(span, key, e.to_string()))
     }
 
@@ -59,7 +75,11 @@ impl Ctx<'_> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
-            Err(self.invalid(v.span(), key, format!("must be a positive finite number, got {x}")))
+            Err(self.invalid(
+                v.span(),
+                key,
+                format!("must be a positive finite number, got {x}"),
+            ))
         }
     }
 
@@ -72,7 +92,12 @@ impl Ctx<'_> {
         }
     }
 
-    fn terms(&self, v: &Option<S<i64>>, default: usize, key: impl Into<String>) -> Result<usize, ScenarioError> {
+    fn terms(
+        &self,
+        v: &Option<S<i64>>,
+        default: usize,
+        key: impl Into<String>,
+    ) -> Result<usize, ScenarioError> {
         match v {
             None => Ok(default),
             Some(t) => {
@@ -80,7 +105,14 @@ impl Ctx<'_> {
                 if (1..=crate::structure::MAX_TERMS as i64).contains(&n) {
                     Ok(n as usize)
                 } else {
-                    Err(self.invalid(t.span(), key, format!("must be between 1 and {}, got {n}", crate::structure::MAX_TERMS)))
+                    Err(self.invalid(
+                        t.span(),
+                        key,
+                        format!(
+                            "must be between 1 and {}, got {n}",
+                            crate::structure::MAX_TERMS
+                        ),
+                    ))
                 }
             }
         }
@@ -102,7 +134,10 @@ fn key_at(src: &str, offset: usize) -> String {
         .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
     let trimmed = line.trim();
     if trimmed.starts_with('[') {
-        return trimmed.trim_matches(|c| c == '[' || c == ']').trim().to_string();
+        return trimmed
+            .trim_matches(|c| c == '[' || c == ']')
+            .trim()
+            .to_string();
     }
     let key = line.split('=').next().unwrap_or("").trim().to_string();
     match (header, key.is_empty() || !line.contains('=')) {
@@ -132,7 +167,11 @@ impl Scenario {
         let cx = Ctx { src, file };
         let raw: RawScenario = toml::from_str(src).map_err(|e| {
             let span = e.span().unwrap_or(0..0);
-            let msg = e.message().trim().to_string();
+            let mut msg = e.message().trim().to_string();
+            if msg.is_empty() {
+                msg = "malformed TOML here (a control character or an unexpected character)"
+                    .to_string();
+            }
             let kind = if msg.starts_with("invalid type")
                 || msg.starts_with("unknown field")
                 || msg.starts_with("missing field")
@@ -145,8 +184,15 @@ impl Scenario {
                 ErrorKind::Syntax
             };
             let mut key = key_at(src, span.start);
-            if let Some(field) = msg.strip_prefix("missing field `").and_then(|r| r.split('`').next()) {
-                key = if key == "(top level)" { field.to_string() } else { format!("{key}.{field}") };
+            if let Some(field) = msg
+                .strip_prefix("missing field `")
+                .and_then(|r| r.split('`').next())
+            {
+                key = if key == "(top level)" {
+                    field.to_string()
+                } else {
+                    format!("{key}.{field}")
+                };
             }
             cx.err(kind, span, key, msg)
         })?;
@@ -157,10 +203,17 @@ impl Scenario {
 fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     if let Some(v) = &raw.format_version {
         if *v.get_ref() != 1 {
-            return Err(cx.invalid(v.span(), "format_version", format!("this flexcraft reads format version 1, got {}", v.get_ref())));
+            return Err(cx.invalid(
+                v.span(),
+                "format_version",
+                format!("this flexcraft reads format version 1, got {}", v.get_ref()),
+            ));
         }
     }
-    let name = raw.name.as_ref().map_or_else(|| "unnamed".to_string(), |n| n.get_ref().clone());
+    let name = raw
+        .name
+        .as_ref()
+        .map_or_else(|| "unnamed".to_string(), |n| n.get_ref().clone());
 
     // Materials.
     let mut materials: BTreeMap<&str, Material> = BTreeMap::new();
@@ -171,7 +224,11 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         let nu_s = &m.get_ref().poisson_ratio;
         let nu = *nu_s.get_ref();
         if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-            return Err(cx.invalid(nu_s.span(), format!("{k}.poisson_ratio"), format!("must lie in (-1, 0.5), got {nu}")));
+            return Err(cx.invalid(
+                nu_s.span(),
+                format!("{k}.poisson_ratio"),
+                format!("must lie in (-1, 0.5), got {nu}"),
+            ));
         }
         let g = match &m.get_ref().shear_modulus {
             Some(g) => Some(cx.positive(g, format!("{k}.shear_modulus"))?),
@@ -183,7 +240,19 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     let material = |s: &S<String>, key: String| -> Result<Material, ScenarioError> {
         materials.get(s.get_ref().as_str()).copied().ok_or_else(|| {
             let known: Vec<&str> = materials.keys().copied().collect();
-            cx.invalid(s.span(), key, format!("unknown material \"{}\" (defined: {})", s.get_ref(), if known.is_empty() { "none".into() } else { known.join(", ") }))
+            cx.invalid(
+                s.span(),
+                key,
+                format!(
+                    "unknown material \"{}\" (defined: {})",
+                    s.get_ref(),
+                    if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            )
         })
     };
 
@@ -195,9 +264,17 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     };
     let hub = match &rh.shape {
         Some(shape) => {
-            for (present, k) in [(rh.mass.is_some(), "mass"), (rh.inertia.is_some(), "inertia"), (rh.center_of_mass.is_some(), "center_of_mass")] {
+            for (present, k) in [
+                (rh.mass.is_some(), "mass"),
+                (rh.inertia.is_some(), "inertia"),
+                (rh.center_of_mass.is_some(), "center_of_mass"),
+            ] {
                 if present {
-                    return Err(cx.invalid(shape.span(), format!("hub.{k}"), "give either shape or mass/inertia/center_of_mass, not both"));
+                    return Err(cx.invalid(
+                        shape.span(),
+                        format!("hub.{k}"),
+                        "give either shape or mass/inertia/center_of_mass, not both",
+                    ));
                 }
             }
             let c = shape.get_ref().cylinder.get_ref();
@@ -206,19 +283,43 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             let w = cx.positive(&c.wall, format!("{k}.wall"))?;
             let l = cx.positive(&c.length, format!("{k}.length"))?;
             if w >= d / 2.0 {
-                return Err(cx.invalid(c.wall.span(), format!("{k}.wall"), format!("wall {w} m is not less than the radius {} m", d / 2.0)));
+                return Err(cx.invalid(
+                    c.wall.span(),
+                    format!("{k}.wall"),
+                    format!("wall {w} m is not less than the radius {} m", d / 2.0),
+                ));
             }
             let axis = cx.vec3(&c.axis, format!("{k}.axis"))?;
             let center = cx.vec3(&c.center, format!("{k}.center"))?;
             let mat = material(&c.material, format!("{k}.material"))?;
-            cx.structural(Hub::cylinder(motion, d, w, l, axis, center, mat.density, c.closed_ends), shape.span(), k)?
+            cx.structural(
+                Hub::cylinder(motion, d, w, l, axis, center, mat.density, c.closed_ends),
+                shape.span(),
+                k,
+            )?
         }
         None => {
-            let missing = |k: &str| cx.err(ErrorKind::Schema, raw.hub.span(), format!("hub.{k}"), format!("missing field `{k}` (or give hub.shape)"));
+            let missing = |k: &str| {
+                cx.err(
+                    ErrorKind::Schema,
+                    raw.hub.span(),
+                    format!("hub.{k}"),
+                    format!("missing field `{k}` (or give hub.shape)"),
+                )
+            };
             let mass = cx.positive(rh.mass.as_ref().ok_or_else(|| missing("mass"))?, "hub.mass")?;
             let inertia_s = rh.inertia.as_ref().ok_or_else(|| missing("inertia"))?;
-            let inertia = cx.structural(inertia_tensor(inertia_s.get_ref()), inertia_s.span(), "hub.inertia")?;
-            let c = cx.vec3(rh.center_of_mass.as_ref().ok_or_else(|| missing("center_of_mass"))?, "hub.center_of_mass")?;
+            let inertia = cx.structural(
+                inertia_tensor(inertia_s.get_ref()),
+                inertia_s.span(),
+                "hub.inertia",
+            )?;
+            let c = cx.vec3(
+                rh.center_of_mass
+                    .as_ref()
+                    .ok_or_else(|| missing("center_of_mass"))?,
+                "hub.center_of_mass",
+            )?;
             cx.structural(Hub::new(motion, mass, c, inertia), raw.hub.span(), "hub")?
         }
     };
@@ -230,23 +331,61 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         station: Range<usize>,
     }
     let mut spans: BTreeMap<String, Spans> = BTreeMap::new();
-    let attach = |key: &str, parent: &S<String>, station: &Option<S<f64>>, point: &Option<S<[f64; 3]>>, point_key: &str| -> Result<Attachment, ScenarioError> {
+    let attach = |key: &str,
+                  parent: &S<String>,
+                  station: &Option<S<f64>>,
+                  point: &Option<S<[f64; 3]>>,
+                  point_key: &str|
+     -> Result<Attachment, ScenarioError> {
         if parent.get_ref() == "hub" {
             if let Some(s) = station {
-                return Err(cx.invalid(s.span(), format!("{key}.station"), format!("station applies to a beam parent; on the hub give {point_key} = [x, y, z]")));
+                return Err(cx.invalid(
+                    s.span(),
+                    format!("{key}.station"),
+                    format!(
+                        "station applies to a beam parent; on the hub give {point_key} = [x, y, z]"
+                    ),
+                ));
             }
-            let p = point.as_ref().ok_or_else(|| cx.err(ErrorKind::Schema, parent.span(), format!("{key}.{point_key}"), format!("missing field `{point_key}`: the attachment point on the hub")))?;
-            Ok(Attachment::Hub { point: cx.vec3(p, format!("{key}.{point_key}"))? })
+            let p = point.as_ref().ok_or_else(|| {
+                cx.err(
+                    ErrorKind::Schema,
+                    parent.span(),
+                    format!("{key}.{point_key}"),
+                    format!("missing field `{point_key}`: the attachment point on the hub"),
+                )
+            })?;
+            Ok(Attachment::Hub {
+                point: cx.vec3(p, format!("{key}.{point_key}"))?,
+            })
         } else {
             if let Some(p) = point {
-                return Err(cx.invalid(p.span(), format!("{key}.{point_key}"), format!("{point_key} applies to the hub; on a beam parent give station")));
+                return Err(cx.invalid(
+                    p.span(),
+                    format!("{key}.{point_key}"),
+                    format!("{point_key} applies to the hub; on a beam parent give station"),
+                ));
             }
-            let s = station.as_ref().ok_or_else(|| cx.err(ErrorKind::Schema, parent.span(), format!("{key}.station"), "missing field `station`: distance from the parent beam's root"))?;
+            let s = station.as_ref().ok_or_else(|| {
+                cx.err(
+                    ErrorKind::Schema,
+                    parent.span(),
+                    format!("{key}.station"),
+                    "missing field `station`: distance from the parent beam's root",
+                )
+            })?;
             let st = *s.get_ref();
             if !(st.is_finite() && st >= 0.0) {
-                return Err(cx.invalid(s.span(), format!("{key}.station"), format!("must be a finite distance >= 0, got {st}")));
+                return Err(cx.invalid(
+                    s.span(),
+                    format!("{key}.station"),
+                    format!("must be a finite distance >= 0, got {st}"),
+                ));
             }
-            Ok(Attachment::Beam { beam: parent.get_ref().clone(), station: st })
+            Ok(Attachment::Beam {
+                beam: parent.get_ref().clone(),
+                station: st,
+            })
         }
     };
 
@@ -261,14 +400,32 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         let sk = format!("{k}.section");
         let section = match &sec.tube {
             Some(t) => {
-                if let Some(s) = [&sec.area, &sec.iy, &sec.iz, &sec.torsion_constant, &sec.polar_inertia].into_iter().flatten().next() {
-                    return Err(cx.invalid(s.span(), sk, "give either tube or the section constants, not both"));
+                if let Some(s) = [
+                    &sec.area,
+                    &sec.iy,
+                    &sec.iz,
+                    &sec.torsion_constant,
+                    &sec.polar_inertia,
+                ]
+                .into_iter()
+                .flatten()
+                .next()
+                {
+                    return Err(cx.invalid(
+                        s.span(),
+                        sk,
+                        "give either tube or the section constants, not both",
+                    ));
                 }
                 let t = t.get_ref();
                 let d = cx.positive(&t.outer_diameter, format!("{sk}.tube.outer_diameter"))?;
                 let w = cx.positive(&t.wall, format!("{sk}.tube.wall"))?;
                 if w >= d / 2.0 {
-                    return Err(cx.invalid(t.wall.span(), format!("{sk}.tube.wall"), format!("wall {w} m is not less than the radius {} m", d / 2.0)));
+                    return Err(cx.invalid(
+                        t.wall.span(),
+                        format!("{sk}.tube.wall"),
+                        format!("wall {w} m is not less than the radius {} m", d / 2.0),
+                    ));
                 }
                 cx.structural(BeamSection::tube(d, w), b.section.span(), sk.clone())?
             }
@@ -276,7 +433,14 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 let need = |v: &Option<S<f64>>, f: &str| -> Result<f64, ScenarioError> {
                     match v {
                         Some(v) => cx.positive(v, format!("{sk}.{f}")),
-                        None => Err(cx.err(ErrorKind::Schema, b.section.span(), format!("{sk}.{f}"), format!("missing field `{f}` (or give tube = {{ outer_diameter, wall }})"))),
+                        None => Err(cx.err(
+                            ErrorKind::Schema,
+                            b.section.span(),
+                            format!("{sk}.{f}"),
+                            format!(
+                                "missing field `{f}` (or give tube = {{ outer_diameter, wall }})"
+                            ),
+                        )),
                     }
                 };
                 let area = need(&sec.area, "area")?;
@@ -284,7 +448,11 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 let iz = need(&sec.iz, "iz")?;
                 let j = need(&sec.torsion_constant, "torsion_constant")?;
                 let ip = need(&sec.polar_inertia, "polar_inertia")?;
-                cx.structural(BeamSection::general(area, iy, iz, j, ip), b.section.span(), sk.clone())?
+                cx.structural(
+                    BeamSection::general(area, iy, iz, j, ip),
+                    b.section.span(),
+                    sk.clone(),
+                )?
             }
         };
         let axis = cx.vec3(&b.axis, format!("{k}.axis"))?;
@@ -294,8 +462,16 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         };
         let frame = match Frame::new(axis, y_axis) {
             Ok(f) => f,
-            Err(e @ StructureError::ZeroAxis { field: "axis" }) => return Err(cx.invalid(b.axis.span(), format!("{k}.axis"), e.to_string())),
-            Err(e) => return Err(cx.invalid(sec.y_axis.as_ref().map_or(b.axis.span(), |y| y.span()), format!("{sk}.y_axis"), e.to_string())),
+            Err(e @ StructureError::ZeroAxis { field: "axis" }) => {
+                return Err(cx.invalid(b.axis.span(), format!("{k}.axis"), e.to_string()))
+            }
+            Err(e) => {
+                return Err(cx.invalid(
+                    sec.y_axis.as_ref().map_or(b.axis.span(), |y| y.span()),
+                    format!("{sk}.y_axis"),
+                    e.to_string(),
+                ))
+            }
         };
         let (tb, tt, ta) = DEFAULT_BEAM_TERMS;
         let terms = match &b.terms {
@@ -310,7 +486,14 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             None => BeamTerms::new(tb, tt, ta),
         };
         let terms = cx.structural(terms, b.name.span(), format!("{k}.terms"))?;
-        spans.insert(b.name.get_ref().clone(), Spans { name: b.name.span(), parent: b.parent.span(), station: b.station.as_ref().map_or(b.parent.span(), |s| s.span()) });
+        spans.insert(
+            b.name.get_ref().clone(),
+            Spans {
+                name: b.name.span(),
+                parent: b.parent.span(),
+                station: b.station.as_ref().map_or(b.parent.span(), |s| s.span()),
+            },
+        );
         beams.push(Beam {
             name: b.name.get_ref().clone(),
             attachment,
@@ -335,49 +518,125 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         let nn = cx.vec3(&p.normal, format!("{k}.normal"))?;
         let (d, mu, nu) = match (&p.material, &p.thickness) {
             (Some(m), Some(h)) => {
-                for (v, f) in [(&p.areal_density, "areal_density"), (&p.bending_stiffness, "bending_stiffness"), (&p.poisson_ratio, "poisson_ratio")] {
+                for (v, f) in [
+                    (&p.areal_density, "areal_density"),
+                    (&p.bending_stiffness, "bending_stiffness"),
+                    (&p.poisson_ratio, "poisson_ratio"),
+                ] {
                     if let Some(v) = v {
                         return Err(cx.invalid(v.span(), format!("{k}.{f}"), "give either thickness + material or areal_density + bending_stiffness + poisson_ratio"));
                     }
                 }
                 let h = cx.positive(h, format!("{k}.thickness"))?;
                 let mat = material(m, format!("{k}.material"))?;
-                let (d, mu) = Plate::homogeneous_properties(h, mat.youngs_modulus, mat.poisson_ratio, mat.density);
+                let (d, mu) = Plate::homogeneous_properties(
+                    h,
+                    mat.youngs_modulus,
+                    mat.poisson_ratio,
+                    mat.density,
+                );
                 (d, mu, mat.poisson_ratio)
             }
             (None, None) => {
-                fn need<'v>(cx: &Ctx, v: &'v Option<S<f64>>, span: Range<usize>, k: &str, f: &str) -> Result<&'v S<f64>, ScenarioError> {
-                    v.as_ref().ok_or_else(|| cx.err(ErrorKind::Schema, span, format!("{k}.{f}"), format!("missing field `{f}` (or give thickness + material)")))
+                fn need<'v>(
+                    cx: &Ctx,
+                    v: &'v Option<S<f64>>,
+                    span: Range<usize>,
+                    k: &str,
+                    f: &str,
+                ) -> Result<&'v S<f64>, ScenarioError> {
+                    v.as_ref().ok_or_else(|| {
+                        cx.err(
+                            ErrorKind::Schema,
+                            span,
+                            format!("{k}.{f}"),
+                            format!("missing field `{f}` (or give thickness + material)"),
+                        )
+                    })
                 }
-                let mu = cx.positive(need(cx, &p.areal_density, p.name.span(), &k, "areal_density")?, format!("{k}.areal_density"))?;
-                let d = cx.positive(need(cx, &p.bending_stiffness, p.name.span(), &k, "bending_stiffness")?, format!("{k}.bending_stiffness"))?;
+                let mu = cx.positive(
+                    need(cx, &p.areal_density, p.name.span(), &k, "areal_density")?,
+                    format!("{k}.areal_density"),
+                )?;
+                let d = cx.positive(
+                    need(
+                        cx,
+                        &p.bending_stiffness,
+                        p.name.span(),
+                        &k,
+                        "bending_stiffness",
+                    )?,
+                    format!("{k}.bending_stiffness"),
+                )?;
                 let nu_s = need(cx, &p.poisson_ratio, p.name.span(), &k, "poisson_ratio")?;
                 let nu = *nu_s.get_ref();
                 if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-                    return Err(cx.invalid(nu_s.span(), format!("{k}.poisson_ratio"), format!("must lie in (-1, 0.5), got {nu}")));
+                    return Err(cx.invalid(
+                        nu_s.span(),
+                        format!("{k}.poisson_ratio"),
+                        format!("must lie in (-1, 0.5), got {nu}"),
+                    ));
                 }
                 (d, mu, nu)
             }
-            (Some(m), None) => return Err(cx.err(ErrorKind::Schema, m.span(), format!("{k}.thickness"), "missing field `thickness` (a plate of a material needs its thickness)")),
-            (None, Some(h)) => return Err(cx.err(ErrorKind::Schema, h.span(), format!("{k}.material"), "missing field `material` (a plate of a given thickness needs its material)")),
+            (Some(m), None) => {
+                return Err(cx.err(
+                    ErrorKind::Schema,
+                    m.span(),
+                    format!("{k}.thickness"),
+                    "missing field `thickness` (a plate of a material needs its thickness)",
+                ))
+            }
+            (None, Some(h)) => {
+                return Err(cx.err(
+                    ErrorKind::Schema,
+                    h.span(),
+                    format!("{k}.material"),
+                    "missing field `material` (a plate of a given thickness needs its material)",
+                ))
+            }
         };
         let (tl, tw) = DEFAULT_PLATE_TERMS;
         let terms = match &p.terms {
             Some(t) => {
                 let t = t.get_ref();
-                PlateTerms::new(cx.terms(&t.length, tl, format!("{k}.terms.length"))?, cx.terms(&t.width, tw, format!("{k}.terms.width"))?)
+                PlateTerms::new(
+                    cx.terms(&t.length, tl, format!("{k}.terms.length"))?,
+                    cx.terms(&t.width, tw, format!("{k}.terms.width"))?,
+                )
             }
             None => PlateTerms::new(tl, tw),
         };
         let terms = cx.structural(terms, p.name.span(), format!("{k}.terms"))?;
-        let plate = Plate::new(p.name.get_ref().clone(), attachment, la, nn, length, width, mu, d, nu, terms).map_err(|e| {
+        let plate = Plate::new(
+            p.name.get_ref().clone(),
+            attachment,
+            la,
+            nn,
+            length,
+            width,
+            mu,
+            d,
+            nu,
+            terms,
+        )
+        .map_err(|e| {
             let (span, f) = match e {
-                StructureError::ZeroAxis { field: "length_axis" } => (p.length_axis.span(), "length_axis"),
+                StructureError::ZeroAxis {
+                    field: "length_axis",
+                } => (p.length_axis.span(), "length_axis"),
                 _ => (p.normal.span(), "normal"),
             };
             cx.invalid(span, format!("{k}.{f}"), e.to_string())
         })?;
-        spans.insert(p.name.get_ref().clone(), Spans { name: p.name.span(), parent: p.parent.span(), station: p.station.as_ref().map_or(p.parent.span(), |s| s.span()) });
+        spans.insert(
+            p.name.get_ref().clone(),
+            Spans {
+                name: p.name.span(),
+                parent: p.parent.span(),
+                station: p.station.as_ref().map_or(p.parent.span(), |s| s.span()),
+            },
+        );
         plates.push(plate);
     }
 
@@ -392,23 +651,58 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             None => Vec3::ZERO,
         };
         let inertia = match &m.inertia {
-            Some(j) => cx.structural(inertia_tensor(j.get_ref()), j.span(), format!("{k}.inertia"))?,
+            Some(j) => cx.structural(
+                inertia_tensor(j.get_ref()),
+                j.span(),
+                format!("{k}.inertia"),
+            )?,
             None => crate::math::Mat3::ZERO,
         };
-        spans.insert(m.name.get_ref().clone(), Spans { name: m.name.span(), parent: m.parent.span(), station: m.station.as_ref().map_or(m.parent.span(), |s| s.span()) });
-        masses.push(LumpedMass { name: m.name.get_ref().clone(), attachment, offset, mass, inertia });
+        spans.insert(
+            m.name.get_ref().clone(),
+            Spans {
+                name: m.name.span(),
+                parent: m.parent.span(),
+                station: m.station.as_ref().map_or(m.parent.span(), |s| s.span()),
+            },
+        );
+        masses.push(LumpedMass {
+            name: m.name.get_ref().clone(),
+            attachment,
+            offset,
+            mass,
+            inertia,
+        });
     }
 
-    let basis = raw.ritz.as_ref().map(|r| r.get_ref().basis).unwrap_or_default();
-    let structure = Structure::new(name.clone(), hub, beams, plates, masses, basis).map_err(|e| {
-        let (span, key) = match &e {
-            StructureError::DuplicateName { name } => (spans.get(name).map(|s| s.name.clone()), "name".to_string()),
-            StructureError::UnknownParent { component, .. } => (spans.get(component).map(|s| s.parent.clone()), format!("{component}.parent")),
-            StructureError::Cycle { path } => (path.first().and_then(|n| spans.get(n)).map(|s| s.parent.clone()), format!("{}.parent", path.first().cloned().unwrap_or_default())),
-            StructureError::StationBeyondParent { component, .. } => (spans.get(component).map(|s| s.station.clone()), format!("{component}.station")),
-            _ => (None, "structure".to_string()),
-        };
-        cx.invalid(span.unwrap_or(0..0), key, e.to_string())
-    })?;
+    let basis = raw
+        .ritz
+        .as_ref()
+        .map(|r| r.get_ref().basis)
+        .unwrap_or_default();
+    let structure =
+        Structure::new(name.clone(), hub, beams, plates, masses, basis).map_err(|e| {
+            let (span, key) = match &e {
+                StructureError::DuplicateName { name } => {
+                    (spans.get(name).map(|s| s.name.clone()), "name".to_string())
+                }
+                StructureError::UnknownParent { component, .. } => (
+                    spans.get(component).map(|s| s.parent.clone()),
+                    format!("{component}.parent"),
+                ),
+                StructureError::Cycle { path } => (
+                    path.first()
+                        .and_then(|n| spans.get(n))
+                        .map(|s| s.parent.clone()),
+                    format!("{}.parent", path.first().cloned().unwrap_or_default()),
+                ),
+                StructureError::StationBeyondParent { component, .. } => (
+                    spans.get(component).map(|s| s.station.clone()),
+                    format!("{component}.station"),
+                ),
+                _ => (None, "structure".to_string()),
+            };
+            cx.invalid(span.unwrap_or(0..0), key, e.to_string())
+        })?;
     Ok(Scenario { name, structure })
 }

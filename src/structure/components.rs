@@ -34,10 +34,20 @@ pub struct Hub {
 impl Hub {
     /// A hub with the given mass properties (inertia already validated by
     /// [`super::inertia_tensor`]).
-    pub fn new(motion: HubMotion, mass: f64, center_of_mass: Vec3, inertia: Mat3) -> Result<Self, StructureError> {
+    pub fn new(
+        motion: HubMotion,
+        mass: f64,
+        center_of_mass: Vec3,
+        inertia: Mat3,
+    ) -> Result<Self, StructureError> {
         positive("mass", mass)?;
         finite_vec("center_of_mass", center_of_mass)?;
-        Ok(Self { motion, mass, center_of_mass, inertia })
+        Ok(Self {
+            motion,
+            mass,
+            center_of_mass,
+            inertia,
+        })
     }
 
     /// The paper's hub: a thin-walled circular cylinder (outer diameter, wall) of the given
@@ -62,10 +72,16 @@ impl Hub {
         let a = unit("axis", axis)?;
         let big_r = diameter / 2.0;
         if wall >= big_r {
-            return Err(StructureError::WallTooThick { wall, radius: big_r });
+            return Err(StructureError::WallTooThick {
+                wall,
+                radius: big_r,
+            });
         }
         if closed_ends && 2.0 * wall >= length {
-            return Err(StructureError::WallTooThick { wall, radius: length / 2.0 });
+            return Err(StructureError::WallTooThick {
+                wall,
+                radius: length / 2.0,
+            });
         }
         let r = big_r - wall;
         let along = a.outer(a);
@@ -85,7 +101,12 @@ impl Hub {
                 body = body.plus(&RigidBody::from_cm(md, a * (s * (length - wall) / 2.0), j));
             }
         }
-        Ok(Self { motion, mass: body.mass, center_of_mass: center, inertia: body.inertia_at_cm() })
+        Ok(Self {
+            motion,
+            mass: body.mass,
+            center_of_mass: center,
+            inertia: body.inertia_at_cm(),
+        })
     }
 
     /// Mass properties about the hub's centre of mass.
@@ -143,22 +164,43 @@ impl BeamSection {
         positive("wall", wall)?;
         let big_r = outer_diameter / 2.0;
         if wall >= big_r {
-            return Err(StructureError::WallTooThick { wall, radius: big_r });
+            return Err(StructureError::WallTooThick {
+                wall,
+                radius: big_r,
+            });
         }
         let r = big_r - wall;
         let pi = std::f64::consts::PI;
         let i = pi * (big_r.powi(4) - r.powi(4)) / 4.0;
-        Ok(Self { area: pi * (big_r * big_r - r * r), iy: i, iz: i, torsion_constant: 2.0 * i, polar_inertia: 2.0 * i })
+        Ok(Self {
+            area: pi * (big_r * big_r - r * r),
+            iy: i,
+            iz: i,
+            torsion_constant: 2.0 * i,
+            polar_inertia: 2.0 * i,
+        })
     }
 
     /// A general section given by its constants (all > 0).
-    pub fn general(area: f64, iy: f64, iz: f64, torsion_constant: f64, polar_inertia: f64) -> Result<Self, StructureError> {
+    pub fn general(
+        area: f64,
+        iy: f64,
+        iz: f64,
+        torsion_constant: f64,
+        polar_inertia: f64,
+    ) -> Result<Self, StructureError> {
         positive("area", area)?;
         positive("iy", iy)?;
         positive("iz", iz)?;
         positive("torsion_constant", torsion_constant)?;
         positive("polar_inertia", polar_inertia)?;
-        Ok(Self { area, iy, iz, torsion_constant, polar_inertia })
+        Ok(Self {
+            area,
+            iy,
+            iz,
+            torsion_constant,
+            polar_inertia,
+        })
     }
 }
 
@@ -224,12 +266,20 @@ impl Frame {
                 y
             }
             None => {
-                let helper = if ex.get(2).abs() < 0.9 { Vec3::unit(2) } else { Vec3::unit(0) };
+                let helper = if ex.get(2).abs() < 0.9 {
+                    Vec3::unit(2)
+                } else {
+                    Vec3::unit(0)
+                };
                 helper.cross(ex).normalized()
             }
         };
         let ey = (ey - ex * ey.dot(ex)).normalized();
-        Ok(Self { ex, ey, ez: ex.cross(ey) })
+        Ok(Self {
+            ex,
+            ey,
+            ez: ex.cross(ey),
+        })
     }
 }
 
@@ -237,7 +287,10 @@ impl Frame {
 pub(super) fn perpendicular(field: &'static str, a: Vec3, b: Vec3) -> Result<(), StructureError> {
     let c = a.dot(b);
     if c.abs() > 1e-6 {
-        return Err(StructureError::NotPerpendicular { field, angle_deg: c.clamp(-1.0, 1.0).acos().to_degrees() });
+        return Err(StructureError::NotPerpendicular {
+            field,
+            angle_deg: c.clamp(-1.0, 1.0).acos().to_degrees(),
+        });
     }
     Ok(())
 }
@@ -306,7 +359,10 @@ pub struct PlateTerms {
 impl PlateTerms {
     /// Validates 1 ≤ terms ≤ 100 in each direction.
     pub fn new(length: usize, width: usize) -> Result<Self, StructureError> {
-        Ok(Self { length: check_terms("length", length)?, width: check_terms("width", width)? })
+        Ok(Self {
+            length: check_terms("length", length)?,
+            width: check_terms("width", width)?,
+        })
     }
 
     /// Generalized coordinates: length × width.
@@ -365,14 +421,30 @@ impl Plate {
         positive("areal_density", areal_density)?;
         positive("bending_stiffness", bending_stiffness)?;
         if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
-            return Err(StructureError::PoissonRatio { value: poisson_ratio });
+            return Err(StructureError::PoissonRatio {
+                value: poisson_ratio,
+            });
         }
-        Ok(Self { name, attachment, length_axis, normal, length, width, areal_density, bending_stiffness, poisson_ratio, terms })
+        Ok(Self {
+            name,
+            attachment,
+            length_axis,
+            normal,
+            length,
+            width,
+            areal_density,
+            bending_stiffness,
+            poisson_ratio,
+            terms,
+        })
     }
 
     /// D = Eh³/12(1 − ν²) and μ = ρh of a homogeneous plate of thickness h.
     pub fn homogeneous_properties(thickness: f64, e: f64, nu: f64, rho: f64) -> (f64, f64) {
-        (e * thickness.powi(3) / (12.0 * (1.0 - nu * nu)), rho * thickness)
+        (
+            e * thickness.powi(3) / (12.0 * (1.0 - nu * nu)),
+            rho * thickness,
+        )
     }
 
     /// Width direction e_b = n × e_a.

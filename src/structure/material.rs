@@ -26,10 +26,17 @@ impl Material {
         super::positive("youngs_modulus", youngs_modulus)?;
         super::positive("density", density)?;
         if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
-            return Err(StructureError::PoissonRatio { value: poisson_ratio });
+            return Err(StructureError::PoissonRatio {
+                value: poisson_ratio,
+            });
         }
         let shear_modulus = shear_modulus.unwrap_or(youngs_modulus / (2.0 * (1.0 + poisson_ratio)));
         super::positive("shear_modulus", shear_modulus)?;
-        Ok(Self { youngs_modulus, poisson_ratio, shear_modulus, density })
+        Ok(Self {
+            youngs_modulus,
+            poisson_ratio,
+            shear_modulus,
+            density,
+        })
     }
 }

@@ -5,7 +5,8 @@ pub mod material;
 pub mod rigid;
 
 pub use components::{
-    Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass, Plate, PlateTerms, MAX_TERMS,
+    Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass, Plate, PlateTerms,
+    MAX_TERMS,
 };
 pub use material::Material;
 pub use rigid::{inertia_tensor, RigidBody};
@@ -70,7 +71,9 @@ pub enum StructureError {
         field: &'static str,
     },
     /// Two directions that must be perpendicular are not.
-    #[error("{field} must be perpendicular to the axis; the angle between them is {angle_deg:.6}°")]
+    #[error(
+        "{field} must be perpendicular to the axis; the angle between them is {angle_deg:.6}°"
+    )]
     NotPerpendicular {
         /// The vector.
         field: &'static str,
@@ -191,27 +194,44 @@ impl Structure {
     ) -> Result<Self, StructureError> {
         let mut seen = std::collections::BTreeSet::new();
         seen.insert("hub".to_string());
-        let names = beams.iter().map(|b| &b.name).chain(plates.iter().map(|p| &p.name)).chain(masses.iter().map(|m| &m.name));
+        let names = beams
+            .iter()
+            .map(|b| &b.name)
+            .chain(plates.iter().map(|p| &p.name))
+            .chain(masses.iter().map(|m| &m.name));
         for n in names {
             if !seen.insert(n.clone()) {
                 return Err(StructureError::DuplicateName { name: n.clone() });
             }
         }
-        let known = beams.iter().map(|b| b.name.as_str()).collect::<Vec<_>>().join(", ");
-        let resolve = |component: &str, att: &Attachment| -> Result<Option<usize>, StructureError> {
+        let known = beams
+            .iter()
+            .map(|b| b.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let resolve = |component: &str,
+                       att: &Attachment|
+         -> Result<Option<usize>, StructureError> {
             match att {
                 Attachment::Hub { point } => {
                     finite_vec("root", *point)?;
                     Ok(None)
                 }
                 Attachment::Beam { beam, station } => {
-                    let idx = beams.iter().position(|b| &b.name == beam).ok_or_else(|| StructureError::UnknownParent {
-                        component: component.to_string(),
-                        parent: beam.clone(),
-                        known: if known.is_empty() { "none".into() } else { known.clone() },
+                    let idx = beams.iter().position(|b| &b.name == beam).ok_or_else(|| {
+                        StructureError::UnknownParent {
+                            component: component.to_string(),
+                            parent: beam.clone(),
+                            known: if known.is_empty() {
+                                "none".into()
+                            } else {
+                                known.clone()
+                            },
+                        }
                     })?;
                     let len = beams[idx].length;
-                    if !(station.is_finite() && *station >= 0.0 && *station <= len * (1.0 + 1e-12)) {
+                    if !(station.is_finite() && *station >= 0.0 && *station <= len * (1.0 + 1e-12))
+                    {
                         return Err(StructureError::StationBeyondParent {
                             component: component.to_string(),
                             parent: beam.clone(),
@@ -223,7 +243,10 @@ impl Structure {
                 }
             }
         };
-        let beam_parent = beams.iter().map(|b| resolve(&b.name, &b.attachment)).collect::<Result<Vec<_>, _>>()?;
+        let beam_parent = beams
+            .iter()
+            .map(|b| resolve(&b.name, &b.attachment))
+            .collect::<Result<Vec<_>, _>>()?;
         for p in &plates {
             resolve(&p.name, &p.attachment)?;
         }
@@ -231,7 +254,16 @@ impl Structure {
             resolve(&m.name, &m.attachment)?;
         }
         let beam_order = topological_order(&beams, &beam_parent)?;
-        Ok(Self { name, hub, beams, plates, masses, basis, beam_order, beam_parent })
+        Ok(Self {
+            name,
+            hub,
+            beams,
+            plates,
+            masses,
+            basis,
+            beam_order,
+            beam_parent,
+        })
     }
 
     /// Beam indices with every parent before its children.
@@ -297,7 +329,10 @@ impl Structure {
     }
 }
 
-fn topological_order(beams: &[Beam], parent: &[Option<usize>]) -> Result<Vec<usize>, StructureError> {
+fn topological_order(
+    beams: &[Beam],
+    parent: &[Option<usize>],
+) -> Result<Vec<usize>, StructureError> {
     // 0 = unvisited, 1 = on the current path, 2 = done.
     let mut state = vec![0u8; beams.len()];
     let mut order = Vec::with_capacity(beams.len());
@@ -309,7 +344,10 @@ fn topological_order(beams: &[Beam], parent: &[Option<usize>]) -> Result<Vec<usi
                 2 => break,
                 1 => {
                     let from = path.iter().position(|&p| p == i).unwrap_or(0);
-                    let mut names: Vec<String> = path[from..].iter().map(|&p: &usize| beams[p].name.clone()).collect();
+                    let mut names: Vec<String> = path[from..]
+                        .iter()
+                        .map(|&p: &usize| beams[p].name.clone())
+                        .collect();
                     names.push(beams[i].name.clone());
                     return Err(StructureError::Cycle { path: names });
                 }

@@ -82,7 +82,9 @@ impl RigidBody {
 pub fn inertia_tensor(values: &[f64]) -> Result<Mat3, StructureError> {
     let j = match values.len() {
         3 => Mat3::diag([values[0], values[1], values[2]]),
-        6 => Mat3::symmetric([values[0], values[1], values[2], values[3], values[4], values[5]]),
+        6 => Mat3::symmetric([
+            values[0], values[1], values[2], values[3], values[4], values[5],
+        ]),
         n => return Err(StructureError::InertiaLength { len: n }),
     };
     if values.iter().any(|v| !v.is_finite()) {

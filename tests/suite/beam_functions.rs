@@ -65,7 +65,11 @@ fn roots_values_and_derivatives_match_high_precision_reference_up_to_n_100() {
         for k in 1..=100 {
             let rk: Vec<&Row> = rows.iter().filter(|row| row.k == k).collect();
             let beta = root(l, r, k);
-            assert!((beta - rk[0].beta).abs() < 1e-12, "{pair} root {k}: {beta} vs {}", rk[0].beta);
+            assert!(
+                (beta - rk[0].beta).abs() < 1e-12,
+                "{pair} root {k}: {beta} vs {}",
+                rk[0].beta
+            );
             assert!((funcs.beta(rigid + k - 1) - rk[0].beta).abs() < 1e-12);
             let e = worst(&rk, |xi| funcs.eval(rigid + k - 1, xi));
             assert!(e < 1e-10, "{pair} function {k}: relative error {e:e}");
@@ -116,7 +120,12 @@ fn families_are_orthonormal() {
         let vals: Vec<Vec<[f64; 4]>> = q.points.iter().map(|&x| f.eval_vec(x)).collect();
         for i in 0..40 {
             for j in 0..40 {
-                let s: f64 = q.weights.iter().zip(&vals).map(|(w, v)| w * v[i][0] * v[j][0]).sum();
+                let s: f64 = q
+                    .weights
+                    .iter()
+                    .zip(&vals)
+                    .map(|(w, v)| w * v[i][0] * v[j][0])
+                    .sum();
                 let want = if i == j { 1.0 } else { 0.0 };
                 assert!((s - want).abs() < 1e-10, "{l:?}-{r:?} ({i},{j}): {s}");
             }

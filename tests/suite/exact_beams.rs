@@ -28,7 +28,10 @@ fn omega(beta: f64) -> f64 {
 
 /// Relative distance from ω to the nearest computed frequency.
 fn nearest(computed: &[f64], w: f64) -> f64 {
-    computed.iter().map(|c| ((c - w) / w).abs()).fold(f64::INFINITY, f64::min)
+    computed
+        .iter()
+        .map(|c| ((c - w) / w).abs())
+        .fold(f64::INFINITY, f64::min)
 }
 
 fn beam_block(parent: &str, root: &str, bending: usize) -> String {

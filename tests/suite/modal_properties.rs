@@ -49,7 +49,10 @@ fn rigid_block_reproduces_total_mass_centre_of_mass_and_inertia() {
         for (i, row) in block.iter().enumerate() {
             for (j, want) in row.iter().enumerate() {
                 let got = model.mass[(i, j)];
-                assert!((got - want).abs() <= 1e-10 * scale, "M[{i}][{j}] = {got}, rigid body {want}");
+                assert!(
+                    (got - want).abs() <= 1e-10 * scale,
+                    "M[{i}][{j}] = {got}, rigid body {want}"
+                );
             }
         }
         assert!((model.mass[(0, 0)] - st.total_mass()).abs() <= 1e-10 * st.total_mass());
@@ -60,7 +63,11 @@ fn rigid_block_reproduces_total_mass_centre_of_mass_and_inertia() {
 fn free_hub_has_exactly_six_rigid_modes_and_modes_are_mass_orthonormal() {
     for src in [SEED, FULL] {
         let (model, modes) = solve(src);
-        let rigid: Vec<_> = modes.modes.iter().filter(|m| m.frequency_hz().abs() < 1e-6).collect();
+        let rigid: Vec<_> = modes
+            .modes
+            .iter()
+            .filter(|m| m.frequency_hz().abs() < 1e-6)
+            .collect();
         assert_eq!(rigid.len(), 6);
         assert!(modes.modes[..6].iter().all(|m| m.rigid));
         assert!(modes.modes[6].frequency_hz() > 1e-3);
@@ -71,8 +78,16 @@ fn free_hub_has_exactly_six_rigid_modes_and_modes_are_mass_orthonormal() {
         for i in 0..g.nrows() {
             for j in 0..g.ncols() {
                 let want = if i == j { 1.0 } else { 0.0 };
-                assert!((g[(i, j)] - want).abs() < 1e-10, "(ΦᵀMΦ)[{i}][{j}] = {}", g[(i, j)]);
-                let w2 = if i == j { modes.modes[i].omega_rad_s.powi(2) } else { 0.0 };
+                assert!(
+                    (g[(i, j)] - want).abs() < 1e-10,
+                    "(ΦᵀMΦ)[{i}][{j}] = {}",
+                    g[(i, j)]
+                );
+                let w2 = if i == j {
+                    modes.modes[i].omega_rad_s.powi(2)
+                } else {
+                    0.0
+                };
                 let scale = modes.modes[i.max(j)].omega_rad_s.powi(2).max(1.0);
                 assert!((kk[(i, j)] - w2).abs() < 1e-8 * scale, "(ΦᵀKΦ)[{i}][{j}]");
             }
@@ -90,17 +105,33 @@ fn free_hub_has_exactly_six_rigid_modes_and_modes_are_mass_orthonormal() {
 #[test]
 fn effective_mass_sum_rises_towards_appendage_mass() {
     let with_terms = |b: usize, t: usize, a: usize, pl: usize, pw: usize| {
-        SEED.replace("bending = 8, torsion = 6, axial = 4", &format!("bending = {b}, torsion = {t}, axial = {a}"))
-            .replace("length = 8, width = 6", &format!("length = {pl}, width = {pw}"))
+        SEED.replace(
+            "bending = 8, torsion = 6, axial = 4",
+            &format!("bending = {b}, torsion = {t}, axial = {a}"),
+        )
+        .replace(
+            "length = 8, width = 6",
+            &format!("length = {pl}, width = {pw}"),
+        )
     };
     let mut prev = [0.0; 6];
-    for (b, t, a, pl, pw) in [(4, 3, 2, 4, 3), (8, 6, 4, 8, 6), (16, 12, 8, 16, 12), (30, 24, 16, 24, 16)] {
+    for (b, t, a, pl, pw) in [
+        (4, 3, 2, 4, 3),
+        (8, 6, 4, 8, 6),
+        (16, 12, 8, 16, 12),
+        (30, 24, 16, 24, 16),
+    ] {
         let (_, modes) = solve(&with_terms(b, t, a, pl, pw));
         let frac = *modes.effective_mass_fractions().last().unwrap();
         eprintln!("terms beam ({b},{t},{a}) plate {pl}×{pw}: effective-mass fractions {frac:.6?}");
         for d in 0..6 {
             assert!(frac[d] <= 1.0 + 1e-10, "direction {d}: {}", frac[d]);
-            assert!(frac[d] >= prev[d] - 1e-12, "direction {d} fell: {} < {}", frac[d], prev[d]);
+            assert!(
+                frac[d] >= prev[d] - 1e-12,
+                "direction {d} fell: {} < {}",
+                frac[d],
+                prev[d]
+            );
         }
         prev = frac;
     }

@@ -37,7 +37,11 @@ fn legendre_16x16_first_six_within_1e_4_of_converged_for_several_aspect_ratios()
         let l = lambdas(aspect, "legendre", 16, 16);
         for (i, (a, c)) in l.iter().zip(&converged).enumerate() {
             let rel = (a - c) / c;
-            assert!((0.0..1e-4).contains(&rel), "a/b = {aspect}, mode {}: {a} vs {c}, {rel:e}", i + 1);
+            assert!(
+                (0.0..1e-4).contains(&rel),
+                "a/b = {aspect}, mode {}: {a} vs {c}, {rel:e}",
+                i + 1
+            );
         }
         if aspect == 1.0 {
             assert!((converged[0] - 3.4710).abs() < 5e-5);
@@ -54,11 +58,19 @@ fn both_bases_converge_monotonically_from_above() {
             for n in [4, 6, 8, 12, 16] {
                 let l = lambdas(aspect, basis, n, n);
                 for (i, (a, c)) in l.iter().zip(&converged).enumerate() {
-                    assert!(*a >= c * (1.0 - 1e-12), "{basis} a/b={aspect} n={n} mode {}: {a} < {c}", i + 1);
+                    assert!(
+                        *a >= c * (1.0 - 1e-12),
+                        "{basis} a/b={aspect} n={n} mode {}: {a} < {c}",
+                        i + 1
+                    );
                 }
                 if let Some(p) = &prev {
                     for (i, (a, b)) in l.iter().zip(p).enumerate() {
-                        assert!(*a <= b * (1.0 + 1e-12), "{basis} a/b={aspect} n={n} mode {} rose: {a} > {b}", i + 1);
+                        assert!(
+                            *a <= b * (1.0 + 1e-12),
+                            "{basis} a/b={aspect} n={n} mode {} rose: {a} > {b}",
+                            i + 1
+                        );
                     }
                 }
                 prev = Some(l);

@@ -1,0 +1,328 @@
+//! The `flexcraft` binary end to end: bad input is refused with file, line:column, key and
+//! reason, exit status 2, and no output left behind; good input writes complete, reproducible
+//! outputs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SEED: &str = include_str!("../../examples/seed.toml");
+const FULL: &str = include_str!("../../examples/full.toml");
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexcraft"))
+}
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("flexcraft-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// (name, source, mutation: (from, to), expected location "line:", key fragment, reason fragment)
+fn bad_cases() -> Vec<(
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static str,
+)> {
+    vec![
+        ("syntax", SEED, "[hub]", "[hub", "hub", "header"),
+        (
+            "unknown key",
+            SEED,
+            "length = 13.0",
+            "lenght = 13.0",
+            "lenght",
+            "unknown field",
+        ),
+        (
+            "missing key",
+            SEED,
+            "length = 13.0\n",
+            "\n",
+            "length",
+            "missing field",
+        ),
+        (
+            "wrong type",
+            SEED,
+            "length = 13.0",
+            "length = \"13\"",
+            "length",
+            "invalid type",
+        ),
+        (
+            "negative size",
+            SEED,
+            "length = 13.0",
+            "length = -13.0",
+            "length",
+            "positive",
+        ),
+        (
+            "non-finite",
+            SEED,
+            "length = 13.0",
+            "length = nan",
+            "length",
+            "positive finite",
+        ),
+        (
+            "negative mass",
+            FULL,
+            "mass = 15.0",
+            "mass = -15.0",
+            "mass",
+            "positive",
+        ),
+        (
+            "poisson",
+            SEED,
+            "poisson_ratio = 0.3\ndensity",
+            "poisson_ratio = 0.5\ndensity",
+            "poisson_ratio",
+            "(-1, 0.5)",
+        ),
+        (
+            "poisson low",
+            SEED,
+            "poisson_ratio = 0.3\nterms",
+            "poisson_ratio = -1.0\nterms",
+            "poisson_ratio",
+            "(-1, 0.5)",
+        ),
+        (
+            "tube wall",
+            SEED,
+            "wall = 0.02 }",
+            "wall = 1.2 }",
+            "wall",
+            "radius",
+        ),
+        (
+            "station",
+            SEED,
+            "station = 13.0 ",
+            "station = 13.5 ",
+            "station",
+            "beyond",
+        ),
+        (
+            "unknown parent",
+            SEED,
+            "parent = \"mast\"",
+            "parent = \"mats\"",
+            "parent",
+            "unknown parent",
+        ),
+        (
+            "cycle",
+            FULL,
+            "parent = \"hub\"\nroot = [0.0, 0.0, 0.0]",
+            "parent = \"boom\"\nstation = 1.0",
+            "parent",
+            "cycle",
+        ),
+        (
+            "zero axis",
+            SEED,
+            "axis = [0.0, 0.0, 1.0]\nlength",
+            "axis = [0.0, 0.0, 0.0]\nlength",
+            "axis",
+            "zero length",
+        ),
+        (
+            "normal",
+            SEED,
+            "normal = [0.0, 0.0, 1.0]",
+            "normal = [1.0, 0.0, 0.5]",
+            "normal",
+            "perpendicular",
+        ),
+        (
+            "inertia pd",
+            FULL,
+            "1100.0, 15.0",
+            "1100.0, 1500.0",
+            "inertia",
+            "positive definite",
+        ),
+        (
+            "inertia triangle",
+            FULL,
+            "[900.0, 1200.0, 1100.0, 15.0, -8.0, 4.0]",
+            "[100.0, 1200.0, 100.0]",
+            "inertia",
+            "triangle",
+        ),
+        (
+            "terms zero",
+            SEED,
+            "bending = 8,",
+            "bending = 0,",
+            "bending",
+            "between 1 and 100",
+        ),
+        (
+            "terms large",
+            SEED,
+            "width = 6 }",
+            "width = 101 }",
+            "width",
+            "between 1 and 100",
+        ),
+        (
+            "basis",
+            SEED,
+            "basis = \"legendre\"",
+            "basis = \"chebyshev\"",
+            "basis",
+            "unknown variant",
+        ),
+    ]
+}
+
+#[test]
+fn bad_input_is_refused_with_location_key_reason_and_exit_2_and_no_output() {
+    let dir = scratch("bad");
+    for (name, src, from, to, key, reason) in bad_cases() {
+        assert!(src.contains(from), "{name}: mutation source not found");
+        let file = dir.join("scenario.toml");
+        std::fs::write(&file, src.replacen(from, to, 1)).unwrap();
+        let out = dir.join("out");
+        let r = bin()
+            .arg("modes")
+            .arg(&file)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert_eq!(r.status.code(), Some(2), "{name}: {err}");
+        assert!(r.stdout.is_empty(), "{name}: printed on stdout");
+        let first = err.lines().next().unwrap_or("");
+        assert!(
+            first.starts_with(&format!("error: {}:", file.display())),
+            "{name}: {err}"
+        );
+        let loc = first[format!("error: {}:", file.display()).len()..]
+            .split(':')
+            .take(2)
+            .collect::<Vec<_>>();
+        assert!(
+            loc.len() == 2 && loc.iter().all(|p| p.parse::<usize>().is_ok_and(|v| v > 0)),
+            "{name}: {first}"
+        );
+        assert!(err.contains(key), "{name}: key {key} not named: {err}");
+        assert!(
+            err.contains(reason),
+            "{name}: reason {reason} not given: {err}"
+        );
+        assert!(!err.contains("panicked"), "{name}");
+        assert!(err.lines().count() <= 24, "{name}: more than a screen");
+        assert_eq!(
+            entries(&dir),
+            vec!["scenario.toml".to_string()],
+            "{name}: output left behind"
+        );
+    }
+    let r = bin()
+        .args(["modes", "/nonexistent/flexcraft.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn outputs_are_complete_and_byte_identical_across_runs() {
+    let dir = scratch("good");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed.toml");
+    for run in ["a", "b"] {
+        let r = bin()
+            .arg("modes")
+            .arg(&scenario)
+            .arg("--out")
+            .arg(dir.join(run))
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    let a = entries(&dir.join("a"));
+    for f in [
+        "modes.json",
+        "frequencies.csv",
+        "coefficients",
+        "shapes",
+        "plots",
+    ] {
+        assert!(a.contains(&f.to_string()), "{f} missing: {a:?}");
+    }
+    let plots = entries(&dir.join("a/plots"));
+    assert!(plots.iter().filter(|p| p.ends_with(".png")).count() >= 6);
+    assert!(plots.iter().filter(|p| p.ends_with(".svg")).count() >= 6);
+    // Every file identical between the two runs.
+    fn walk(root: &Path, rel: &Path, out: &mut Vec<PathBuf>) {
+        for e in std::fs::read_dir(root.join(rel)).unwrap() {
+            let e = e.unwrap();
+            let r = rel.join(e.file_name());
+            if e.file_type().unwrap().is_dir() {
+                walk(root, &r, out);
+            } else {
+                out.push(r);
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(&dir.join("a"), Path::new(""), &mut files);
+    assert!(files.len() > 20);
+    for f in &files {
+        let x = std::fs::read(dir.join("a").join(f)).unwrap();
+        let y = std::fs::read(dir.join("b").join(f)).unwrap();
+        assert!(x == y, "{} differs between runs", f.display());
+    }
+    // The JSON on stdout is the same object as modes.json, and carries the interface keys.
+    let r = bin()
+        .arg("modes")
+        .arg(&scenario)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    let file: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("a/modes.json")).unwrap()).unwrap();
+    assert_eq!(v, file);
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(v["dof"].as_u64().unwrap() as usize, modes.len());
+    for (i, m) in modes.iter().enumerate() {
+        assert_eq!(m["number"].as_u64().unwrap() as usize, i + 1);
+        assert_eq!(m["rigid"].as_bool().unwrap(), i < 6);
+        let f = m["frequency_hz"].as_f64().unwrap();
+        let w = m["omega_rad_s"].as_f64().unwrap();
+        assert!((w - 2.0 * std::f64::consts::PI * f).abs() <= 1e-12 * w.max(1.0));
+        assert!(m["dominant"].is_string() && m["strain_energy_share"].is_object());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn help_states_si_units() {
+    for args in [vec!["--help"], vec!["modes", "--help"]] {
+        let r = bin().args(&args).output().unwrap();
+        let s = String::from_utf8_lossy(&r.stdout);
+        assert!(s.contains("SI"), "{args:?}: {s}");
+    }
+}
