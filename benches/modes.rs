@@ -1,1 +1,55 @@
-fn main() {}
+//! Modal-analysis benchmarks (issue 2 targets): assembly + eigen-solve of the seed structure
+//! at the default terms and at the term counts where its first 10 elastic frequencies are
+//! converged to 1e-5 and 1e-6 relative (see docs/convergence.md), and a 1000-DOF model.
+//! Run: `scripts/bench.sh` (prints the figures) or `cargo bench --bench modes`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use flexcraft::{ModalAnalysis, RitzModel, Scenario};
+use std::hint::black_box;
+
+const SEED: &str = include_str!("../examples/seed.toml");
+
+/// The seed scenario with other term counts: beam (bending, torsion, axial), plate (length, width).
+fn seed_with(beam: (usize, usize, usize), plate: (usize, usize)) -> Scenario {
+    let src = SEED
+        .replace(
+            "bending = 8, torsion = 6, axial = 4",
+            &format!(
+                "bending = {}, torsion = {}, axial = {}",
+                beam.0, beam.1, beam.2
+            ),
+        )
+        .replace(
+            "length = 8, width = 6",
+            &format!("length = {}, width = {}", plate.0, plate.1),
+        );
+    Scenario::from_toml_str(&src, "seed.toml").expect("seed scenario")
+}
+
+fn solve(s: &Scenario) -> ModalAnalysis {
+    let model = RitzModel::assemble(&s.structure);
+    ModalAnalysis::compute(&model).expect("modes")
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("modes");
+    g.sample_size(10);
+    let cases = [
+        ("seed default terms (80 DOF)", (8, 6, 4), (8, 6)),
+        ("seed first 10 to 1e-5 (716 DOF)", (12, 8, 6), (48, 14)),
+        ("seed first 10 to 1e-6 (1256 DOF)", (16, 10, 8), (60, 20)),
+        ("seed 1000 DOF", (14, 8, 6), (56, 17)),
+    ];
+    for (name, beam, plate) in cases {
+        let s = seed_with(beam, plate);
+        g.bench_function(name, |b| b.iter(|| black_box(solve(black_box(&s)))));
+    }
+    let s = Scenario::from_toml_str(SEED, "seed.toml").expect("seed");
+    g.bench_function("seed default: assembly only", |b| {
+        b.iter(|| black_box(RitzModel::assemble(black_box(&s.structure))))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -116,7 +116,6 @@ impl ModalAnalysis {
                         shape[HUB_DOF + i] = phi_f[(i, j)];
                     }
                     modes.push(elastic_mode(
-                        model,
                         lam_f[j],
                         shape,
                         Some(hub_fixed[j].effective_mass),
@@ -144,10 +143,11 @@ impl ModalAnalysis {
                     for r in 0..HUB_DOF {
                         shape[r] = -(0..ne).map(|i| x[(r, i)] * phi[(i, j)]).sum::<f64>();
                     }
-                    modes.push(elastic_mode(model, lam[j], shape, None));
+                    modes.push(elastic_mode(lam[j], shape, None));
                 }
             }
         }
+        strain_energy_shares(model, &mut modes);
         for (i, md) in modes.iter_mut().enumerate() {
             md.number = i + 1;
         }
@@ -207,39 +207,53 @@ fn fix_sign(shape: &mut [f64]) {
     }
 }
 
-fn elastic_mode(
-    model: &RitzModel,
-    lambda: f64,
-    mut shape: Vec<f64>,
-    eff: Option<[f64; 6]>,
-) -> Mode {
+fn elastic_mode(lambda: f64, mut shape: Vec<f64>, eff: Option<[f64; 6]>) -> Mode {
     fix_sign(&mut shape);
-    let k = &model.stiffness;
-    let mut shares = Vec::new();
-    for e in &model.elements {
-        if matches!(e.basis, ElementBasis::Rigid) {
-            continue;
-        }
-        let r = e.own_range();
-        let mut en = 0.0;
-        for i in r.clone() {
-            for j in r.clone() {
-                en += shape[i] * k[(i, j)] * shape[j];
-            }
-        }
-        shares.push((model.structure.component_name(e.id).to_string(), 0.5 * en));
-    }
-    let total: f64 = shares.iter().map(|s| s.1).sum();
-    for s in &mut shares {
-        s.1 = if total > 0.0 { s.1 / total } else { 0.0 };
-    }
     Mode {
         number: 0,
         rigid: false,
         omega_rad_s: lambda.max(0.0).sqrt(),
         shape,
-        strain_energy_share: shares,
+        strain_energy_share: Vec::new(),
         effective_mass: eff,
+    }
+}
+
+/// Strain-energy share of each elastic component in every elastic mode:
+/// U_c = ½ φ_cᵀ K_cc φ_c (K is block-diagonal over the components' own coordinates), as
+/// fractions of Σ_c U_c. One matrix product per component for all modes at once.
+fn strain_energy_shares(model: &RitzModel, modes: &mut [Mode]) {
+    let elastic: Vec<usize> = (0..modes.len()).filter(|&j| !modes[j].rigid).collect();
+    if elastic.is_empty() {
+        return;
+    }
+    let nm = elastic.len();
+    let mut energies: Vec<(String, Vec<f64>)> = Vec::new();
+    for e in &model.elements {
+        if matches!(e.basis, ElementBasis::Rigid) {
+            continue;
+        }
+        let r = e.own_range();
+        let len = r.len();
+        let kb = model.stiffness.submatrix(r.start, r.start, len, len);
+        let pb = Mat::from_fn(len, nm, |i, j| modes[elastic[j]].shape[r.start + i]);
+        let kp = kb * &pb;
+        let en = (0..nm)
+            .map(|j| 0.5 * (0..len).map(|i| pb[(i, j)] * kp[(i, j)]).sum::<f64>())
+            .collect();
+        energies.push((model.structure.component_name(e.id).to_string(), en));
+    }
+    for (col, &j) in elastic.iter().enumerate() {
+        let total: f64 = energies.iter().map(|(_, en)| en[col]).sum();
+        modes[j].strain_energy_share = energies
+            .iter()
+            .map(|(name, en)| {
+                (
+                    name.clone(),
+                    if total > 0.0 { en[col] / total } else { 0.0 },
+                )
+            })
+            .collect();
     }
 }
 
