@@ -116,11 +116,7 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
             m.dominant()
         );
         for n in &names {
-            let v = m
-                .strain_energy_share
-                .iter()
-                .find(|(k, _)| k == n)
-                .map(|x| x.1);
+            let v = m.share(n);
             match v {
                 Some(v) => {
                     let _ = write!(s, " {:>8.4}", v);
@@ -223,11 +219,7 @@ pub fn write_modes(
             m.dominant()
         );
         for n in &names {
-            let v = m
-                .strain_energy_share
-                .iter()
-                .find(|(k, _)| k == n)
-                .map_or(0.0, |x| x.1);
+            let v = m.share(n).unwrap_or(0.0);
             let _ = write!(f, ",{}", csv_num(v));
         }
         for d in 0..6 {

@@ -44,6 +44,26 @@ impl Mode {
         self.omega_rad_s / (2.0 * std::f64::consts::PI)
     }
 
+    /// A zero-frequency rigid-body mode with the given shape.
+    fn rigid_body(shape: Vec<f64>) -> Self {
+        Self {
+            number: 0,
+            rigid: true,
+            omega_rad_s: 0.0,
+            shape,
+            strain_energy_share: Vec::new(),
+            effective_mass: None,
+        }
+    }
+
+    /// The strain-energy share of the named component (None for rigid modes).
+    pub fn share(&self, component: &str) -> Option<f64> {
+        self.strain_energy_share
+            .iter()
+            .find(|(k, _)| k == component)
+            .map(|x| x.1)
+    }
+
     /// The component with the largest strain-energy share ("rigid" for rigid modes).
     pub fn dominant(&self) -> &str {
         self.strain_energy_share
@@ -277,14 +297,7 @@ fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
     for a in 0..3 {
         let mut shape = vec![0.0; n];
         shape[a] = 1.0 / mass.sqrt();
-        out.push(Mode {
-            number: 0,
-            rigid: true,
-            omega_rad_s: 0.0,
-            shape,
-            strain_energy_share: Vec::new(),
-            effective_mass: None,
-        });
+        out.push(Mode::rigid_body(shape));
     }
     for (a, &ia) in principal.iter().enumerate() {
         let axis = Vec3::new(axes.get(0, a), axes.get(1, a), axes.get(2, a));
@@ -297,14 +310,7 @@ fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
             shape[3 + i] = th.get(i);
         }
         fix_sign(&mut shape);
-        out.push(Mode {
-            number: 0,
-            rigid: true,
-            omega_rad_s: 0.0,
-            shape,
-            strain_energy_share: Vec::new(),
-            effective_mass: None,
-        });
+        out.push(Mode::rigid_body(shape));
     }
     let _ = n;
     out

@@ -330,6 +330,16 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         parent: Range<usize>,
         station: Range<usize>,
     }
+    impl Spans {
+        /// Where a component's name, parent and attachment station were written.
+        fn of(name: &S<String>, parent: &S<String>, station: &Option<S<f64>>) -> Self {
+            Self {
+                name: name.span(),
+                parent: parent.span(),
+                station: station.as_ref().map_or(parent.span(), |s| s.span()),
+            }
+        }
+    }
     let mut spans: BTreeMap<String, Spans> = BTreeMap::new();
     let attach = |key: &str,
                   parent: &S<String>,
@@ -488,11 +498,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         let terms = cx.structural(terms, b.name.span(), format!("{k}.terms"))?;
         spans.insert(
             b.name.get_ref().clone(),
-            Spans {
-                name: b.name.span(),
-                parent: b.parent.span(),
-                station: b.station.as_ref().map_or(b.parent.span(), |s| s.span()),
-            },
+            Spans::of(&b.name, &b.parent, &b.station),
         );
         beams.push(Beam {
             name: b.name.get_ref().clone(),
@@ -631,11 +637,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         })?;
         spans.insert(
             p.name.get_ref().clone(),
-            Spans {
-                name: p.name.span(),
-                parent: p.parent.span(),
-                station: p.station.as_ref().map_or(p.parent.span(), |s| s.span()),
-            },
+            Spans::of(&p.name, &p.parent, &p.station),
         );
         plates.push(plate);
     }
@@ -660,11 +662,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         };
         spans.insert(
             m.name.get_ref().clone(),
-            Spans {
-                name: m.name.span(),
-                parent: m.parent.span(),
-                station: m.station.as_ref().map_or(m.parent.span(), |s| s.span()),
-            },
+            Spans::of(&m.name, &m.parent, &m.station),
         );
         masses.push(LumpedMass {
             name: m.name.get_ref().clone(),
