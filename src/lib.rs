@@ -15,6 +15,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod basis;
+pub mod deploy;
 pub mod math;
 pub mod output;
 pub mod ritz;

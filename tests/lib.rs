@@ -8,6 +8,7 @@ mod suite {
     pub mod beam_functions;
     pub mod cli;
     pub mod common;
+    pub mod deploy;
     pub mod exact_beams;
     pub mod modal_properties;
     pub mod mutations;

@@ -1,0 +1,302 @@
+//! Dormand–Prince 5(4) with dense output and event location.
+//!
+//! Hand-written (≈ 200 lines) because the deployment needs three things at once that the
+//! Rust ODE crates we know do not expose together: access to the continuous extension of every
+//! accepted step (for samples at exactly k/output_rate), event location on that extension to
+//! 1e-9 s or better, and a restart with new state after an impulsive event. The coefficients
+//! are those of E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential
+//! Equations I*, 2nd ed., Springer 1993, §II.5–6 (DOPRI5, with the 4th-order dense output of
+//! its code `dopri5`).
+
+/// One right-hand side y' = f(t, y).
+pub trait OdeSystem {
+    /// Writes f(t, y) into `dy`.
+    fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]);
+}
+
+const C2: f64 = 1.0 / 5.0;
+const C3: f64 = 3.0 / 10.0;
+const C4: f64 = 4.0 / 5.0;
+const C5: f64 = 8.0 / 9.0;
+const A21: f64 = 1.0 / 5.0;
+const A31: f64 = 3.0 / 40.0;
+const A32: f64 = 9.0 / 40.0;
+const A41: f64 = 44.0 / 45.0;
+const A42: f64 = -56.0 / 15.0;
+const A43: f64 = 32.0 / 9.0;
+const A51: f64 = 19372.0 / 6561.0;
+const A52: f64 = -25360.0 / 2187.0;
+const A53: f64 = 64448.0 / 6561.0;
+const A54: f64 = -212.0 / 729.0;
+const A61: f64 = 9017.0 / 3168.0;
+const A62: f64 = -355.0 / 33.0;
+const A63: f64 = 46732.0 / 5247.0;
+const A64: f64 = 49.0 / 176.0;
+const A65: f64 = -5103.0 / 18656.0;
+const A71: f64 = 35.0 / 384.0;
+const A73: f64 = 500.0 / 1113.0;
+const A74: f64 = 125.0 / 192.0;
+const A75: f64 = -2187.0 / 6784.0;
+const A76: f64 = 11.0 / 84.0;
+const E1: f64 = 71.0 / 57600.0;
+const E3: f64 = -71.0 / 16695.0;
+const E4: f64 = 71.0 / 1920.0;
+const E5: f64 = -17253.0 / 339200.0;
+const E6: f64 = 22.0 / 525.0;
+const E7: f64 = -1.0 / 40.0;
+const D1: f64 = -12715105075.0 / 11282082432.0;
+const D3: f64 = 87487479700.0 / 32700410799.0;
+const D4: f64 = -10690763975.0 / 1880347072.0;
+const D5: f64 = 701980252875.0 / 199316789632.0;
+const D6: f64 = -1453857185.0 / 822651844.0;
+const D7: f64 = 69997945.0 / 29380423.0;
+
+/// The continuous extension of one accepted step on [t0, t0 + h] (4th order).
+#[derive(Debug, Clone)]
+pub struct DenseStep {
+    /// Start of the step.
+    pub t0: f64,
+    /// Step length.
+    pub h: f64,
+    r: [Vec<f64>; 5],
+}
+
+impl DenseStep {
+    /// End of the step.
+    pub fn t1(&self) -> f64 {
+        self.t0 + self.h
+    }
+
+    /// y(t) for t in the step (extrapolates slightly outside).
+    pub fn eval(&self, t: f64, out: &mut [f64]) {
+        let s = (t - self.t0) / self.h;
+        let s1 = 1.0 - s;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.r[0][i]
+                + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])));
+        }
+    }
+
+    /// Component i of y(t).
+    pub fn component(&self, i: usize, t: f64) -> f64 {
+        let s = (t - self.t0) / self.h;
+        let s1 = 1.0 - s;
+        self.r[0][i]
+            + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])))
+    }
+}
+
+/// Adaptive DOPRI5 stepper. Error control: ‖err_i / (atol + rtol·max(|y0_i|, |y1_i|))‖_rms ≤ 1.
+#[derive(Debug, Clone)]
+pub struct Dopri5 {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance.
+    pub atol: f64,
+    /// Largest step allowed.
+    pub h_max: f64,
+    h: f64,
+    k1: Vec<f64>,
+    fresh: bool,
+    /// Number of right-hand-side evaluations so far.
+    pub evaluations: usize,
+}
+
+impl Dopri5 {
+    /// A stepper with the given tolerances and largest step.
+    pub fn new(rtol: f64, atol: f64, h_max: f64) -> Self {
+        Self {
+            rtol,
+            atol,
+            h_max,
+            h: 0.0,
+            k1: Vec::new(),
+            fresh: true,
+            evaluations: 0,
+        }
+    }
+
+    /// Forget the derivative at the current point (after an impulsive change of state).
+    pub fn restart(&mut self) {
+        self.fresh = true;
+    }
+
+    fn initial_step(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> f64 {
+        // Hairer's starting-step heuristic (HINIT), order 5.
+        let n = y.len();
+        let sk: Vec<f64> = y.iter().map(|v| self.atol + self.rtol * v.abs()).collect();
+        let rms = |v: &[f64]| {
+            (v.iter().zip(&sk).map(|(a, s)| (a / s).powi(2)).sum::<f64>() / n as f64).sqrt()
+        };
+        let d0 = rms(y);
+        let d1 = rms(&self.k1);
+        let mut h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
+        h0 = h0.min(self.h_max);
+        let y1: Vec<f64> = y.iter().zip(&self.k1).map(|(a, k)| a + h0 * k).collect();
+        let mut f1 = vec![0.0; n];
+        sys.rhs(t + h0, &y1, &mut f1);
+        self.evaluations += 1;
+        let diff: Vec<f64> = f1.iter().zip(&self.k1).map(|(a, b)| a - b).collect();
+        let d2 = rms(&diff) / h0;
+        let dm = d1.max(d2);
+        let h1 = if dm <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / dm).powf(1.0 / 5.0)
+        };
+        (100.0 * h0).min(h1).min(self.h_max)
+    }
+
+    /// Takes one accepted step from (t, y) towards at most `t_end`; updates t and y and returns
+    /// the step's continuous extension.
+    pub fn step(
+        &mut self,
+        sys: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_end: f64,
+    ) -> DenseStep {
+        let n = y.len();
+        if self.fresh || self.k1.len() != n {
+            self.k1 = vec![0.0; n];
+            sys.rhs(*t, y, &mut self.k1);
+            self.evaluations += 1;
+            self.h = self.initial_step(sys, *t, y);
+            self.fresh = false;
+        }
+        let mut k = vec![vec![0.0; n]; 6];
+        let mut yt = vec![0.0; n];
+        let mut y1 = vec![0.0; n];
+        loop {
+            let mut h = self.h.min(self.h_max);
+            let last = *t + h >= t_end - 1e-12 * t_end.abs().max(1.0);
+            if last {
+                h = t_end - *t;
+            }
+            let k1 = &self.k1;
+            for i in 0..n {
+                yt[i] = y[i] + h * A21 * k1[i];
+            }
+            sys.rhs(*t + C2 * h, &yt, &mut k[0]);
+            for i in 0..n {
+                yt[i] = y[i] + h * (A31 * k1[i] + A32 * k[0][i]);
+            }
+            sys.rhs(*t + C3 * h, &yt, &mut k[1]);
+            for i in 0..n {
+                yt[i] = y[i] + h * (A41 * k1[i] + A42 * k[0][i] + A43 * k[1][i]);
+            }
+            sys.rhs(*t + C4 * h, &yt, &mut k[2]);
+            for i in 0..n {
+                yt[i] = y[i] + h * (A51 * k1[i] + A52 * k[0][i] + A53 * k[1][i] + A54 * k[2][i]);
+            }
+            sys.rhs(*t + C5 * h, &yt, &mut k[3]);
+            for i in 0..n {
+                yt[i] = y[i]
+                    + h * (A61 * k1[i]
+                        + A62 * k[0][i]
+                        + A63 * k[1][i]
+                        + A64 * k[2][i]
+                        + A65 * k[3][i]);
+            }
+            sys.rhs(*t + h, &yt, &mut k[4]);
+            for i in 0..n {
+                y1[i] = y[i]
+                    + h * (A71 * k1[i]
+                        + A73 * k[1][i]
+                        + A74 * k[2][i]
+                        + A75 * k[3][i]
+                        + A76 * k[4][i]);
+            }
+            sys.rhs(*t + h, &y1, &mut k[5]);
+            self.evaluations += 6;
+            // k[0..6] hold k2..k7.
+            let mut err = 0.0;
+            for i in 0..n {
+                let e = h
+                    * (E1 * k1[i]
+                        + E3 * k[1][i]
+                        + E4 * k[2][i]
+                        + E5 * k[3][i]
+                        + E6 * k[4][i]
+                        + E7 * k[5][i]);
+                let sc = self.atol + self.rtol * y[i].abs().max(y1[i].abs());
+                err += (e / sc).powi(2);
+            }
+            let err = (err / n as f64).sqrt();
+            let fac = if err == 0.0 {
+                5.0
+            } else {
+                (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+            };
+            if err <= 1.0 || h.abs() < 1e-14 * t.abs().max(1.0) {
+                let ydiff: Vec<f64> = (0..n).map(|i| y1[i] - y[i]).collect();
+                let bspl: Vec<f64> = (0..n).map(|i| h * k1[i] - ydiff[i]).collect();
+                let r4: Vec<f64> = (0..n).map(|i| ydiff[i] - h * k[5][i] - bspl[i]).collect();
+                let r5: Vec<f64> = (0..n)
+                    .map(|i| {
+                        h * (D1 * k1[i]
+                            + D3 * k[1][i]
+                            + D4 * k[2][i]
+                            + D5 * k[3][i]
+                            + D6 * k[4][i]
+                            + D7 * k[5][i])
+                    })
+                    .collect();
+                let dense = DenseStep {
+                    t0: *t,
+                    h,
+                    r: [y.to_vec(), ydiff, bspl, r4, r5],
+                };
+                *t = if last { t_end } else { *t + h };
+                y.copy_from_slice(&y1);
+                self.k1.copy_from_slice(&k[5]);
+                if !last {
+                    self.h = h * fac;
+                }
+                return dense;
+            }
+            self.h = h * fac.min(1.0);
+        }
+    }
+}
+
+/// The first root in (a, b] of g along a dense step, located by bisection refined with the
+/// secant (Illinois) method to |Δt| ≤ tol. `g(a)` and `g(b)` must have opposite signs.
+pub fn locate(g: impl Fn(f64) -> f64, mut a: f64, mut b: f64, tol: f64) -> f64 {
+    let mut fa = g(a);
+    let mut fb = g(b);
+    let mut side = 0;
+    for _ in 0..200 {
+        if (b - a).abs() <= tol {
+            break;
+        }
+        let mut m = (a * fb - b * fa) / (fb - fa);
+        if !(m > a && m < b) {
+            m = 0.5 * (a + b);
+        }
+        let fm = g(m);
+        if fm == 0.0 {
+            return m;
+        }
+        if (fm > 0.0) == (fa > 0.0) {
+            a = m;
+            fa = fm;
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            b = m;
+            fb = fm;
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    b
+}
