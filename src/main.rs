@@ -31,6 +31,19 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
+    /// Deployment of the accordion-folded array in [deployment]: hinge springs, loads,
+    /// latching with impact, hub disturbance.
+    #[command(after_help = UNITS)]
+    Deploy {
+        /// Scenario file (TOML, format version 1, with a [deployment] section).
+        scenario: PathBuf,
+        /// Print one JSON object on stdout instead of the event table.
+        #[arg(long)]
+        json: bool,
+        /// Also write deployment.csv, events.json and plots here.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -41,6 +54,11 @@ fn main() -> ExitCode {
             json,
             out,
         } => run_modes(&scenario, json, out.as_deref()),
+        Command::Deploy {
+            scenario,
+            json,
+            out,
+        } => run_deploy(&scenario, json, out.as_deref()),
     }
 }
 
@@ -76,6 +94,49 @@ fn run_modes(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) 
             Ok(files) => {
                 if !json {
                     println!("wrote {} files to {}", files, dir.display());
+                }
+            }
+            Err(e) => {
+                eprintln!("error: writing {}: {e}", dir.display());
+                return ExitCode::from(1);
+            }
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// `flexcraft deploy`: exit 2 on a refused scenario (or one without [deployment]), 1 when an
+/// output cannot be written; an array that does not latch is a result, not an error (0).
+fn run_deploy(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
+    let scenario = match Scenario::from_file(path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let Some(d) = &scenario.deployment else {
+        eprintln!(
+            "error: {}: deployment: the scenario has no [deployment] section (see docs/scenario.md)",
+            path.display()
+        );
+        return ExitCode::from(2);
+    };
+    let result = flexcraft::deploy::simulate(d);
+    if json {
+        emit(&(output::deploy_json(&scenario.name, d, &result) + "\n"));
+    } else {
+        emit(&output::deploy_table(&scenario.name, d, &result));
+    }
+    if let Some(dir) = out {
+        let written = OutputDir::create(dir).and_then(|mut o| {
+            output::write_deploy(&mut o, &scenario.name, d, &result)?;
+            o.commit()
+        });
+        match written {
+            Ok(files) => {
+                if !json {
+                    emit(&format!("wrote {} files to {}\n", files, dir.display()));
                 }
             }
             Err(e) => {

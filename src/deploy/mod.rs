@@ -248,6 +248,26 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
             samples.push(sample(chain, tk, &buf, &sys.free));
             next_k += 1;
         }
+        // Swing-back below the initial angle: locate its first time on the dense output.
+        let t_seen = event.map_or(t, |e| e.0);
+        for i in 0..nh {
+            let a0 = chain.hinges[i].initial_angle;
+            let g = |tt: f64| a0 - 1e-12 - step.component(h + i, tt);
+            let mut a = t_start;
+            for s in 1..=8 {
+                let b = t_start + (t_seen - t_start) * s as f64 / 8.0;
+                let gb = g(b);
+                if gb > 0.0 {
+                    let first = if swing[i].is_none() && g(a) <= 0.0 { locate(g, a, b, event_tol * b.abs().max(1.0)) } else { b };
+                    let angle = step.component(h + i, b);
+                    match &mut swing[i] {
+                        Some(sb) => sb.min_angle = sb.min_angle.min(angle),
+                        None => swing[i] = Some(SwingBack { hinge: i + 1, first_time: first, min_angle: angle }),
+                    }
+                }
+                a = b;
+            }
+        }
         match event {
             None => check_swing(&mut swing, t, &y[h..n]),
             Some((te, j)) => {

@@ -2,10 +2,12 @@
 //! time stamps; shortest round-trip float formatting) and written through [`OutputDir`].
 
 mod atomic;
+mod deploy;
 mod modes;
 pub mod plot;
 
 pub use atomic::OutputDir;
+pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
 
 use thiserror::Error;

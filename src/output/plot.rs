@@ -186,3 +186,113 @@ pub fn mode_shape(dir: &mut OutputDir, model: &RitzModel, mode: &Mode) -> Result
     }
     Ok(())
 }
+
+/// A named polyline for [`line_chart`].
+pub type Series = (String, Vec<(f64, f64)>);
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(20, 90, 200),
+    RGBColor(220, 60, 40),
+    RGBColor(30, 150, 70),
+    RGBColor(150, 60, 180),
+    RGBColor(230, 140, 20),
+    RGBColor(20, 160, 170),
+    RGBColor(120, 120, 120),
+    RGBColor(180, 40, 120),
+];
+
+fn draw_chart<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+    equal_aspect: bool,
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let pts = series.iter().flat_map(|s| s.1.iter());
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for &(x, y) in pts {
+        if x.is_finite() && y.is_finite() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if !x0.is_finite() {
+        (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
+    }
+    if x1 - x0 < 1e-12 {
+        x1 = x0 + 1.0;
+    }
+    if y1 - y0 < 1e-12 * (y0.abs() + y1.abs()).max(1e-30) {
+        let c = 0.5 * (y0 + y1);
+        let d = (c.abs() * 0.1).max(1e-9);
+        (y0, y1) = (c - d, c + d);
+    }
+    if equal_aspect {
+        let (w, h) = root.dim_in_pixel();
+        let span = ((x1 - x0) / w as f64).max((y1 - y0) / h as f64);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        (x0, x1) = (cx - 0.5 * span * w as f64, cx + 0.5 * span * w as f64);
+        (y0, y1) = (cy - 0.5 * span * h as f64, cy + 0.5 * span * h as f64);
+    }
+    let pad = 0.04 * (y1 - y0);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.0)
+        .y_desc(labels.1)
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for (i, (name, pts)) in series.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let drawn = chart
+            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+            .map_err(|e| e.to_string())?;
+        if !name.is_empty() {
+            drawn.label(name.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        }
+    }
+    if series.iter().any(|s| !s.0.is_empty()) && series.len() <= 12 {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    root.present().map_err(|e| e.to_string())
+}
+
+/// plots/STEM.png and .svg: a line chart of the given series (equal axis scales on request).
+pub fn line_chart(
+    dir: &mut OutputDir,
+    stem: &str,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+    equal_aspect: bool,
+) -> Result<(), OutputError> {
+    register_font();
+    for ext in ["png", "svg"] {
+        let rel = format!("plots/{stem}.{ext}");
+        let path = dir.path(&rel)?;
+        let size = (1000, 600);
+        let r = if ext == "png" {
+            draw_chart(BitMapBackend::new(&path, size).into_drawing_area(), title, labels, series, equal_aspect)
+        } else {
+            draw_chart(SVGBackend::new(&path, size).into_drawing_area(), title, labels, series, equal_aspect)
+        };
+        r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
+    }
+    Ok(())
+}

@@ -23,6 +23,7 @@ pub struct RawScenario {
     #[serde(default)]
     pub masses: Vec<S<RawMass>>,
     pub ritz: Option<S<RawRitz>>,
+    pub deployment: Option<S<RawDeployment>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -154,4 +155,49 @@ pub struct RawMass {
 pub struct RawRitz {
     #[serde(default)]
     pub basis: BasisKind,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawLatching {
+    Sequential,
+    Simultaneous,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDeployment {
+    pub plate: S<String>,
+    pub panels: Option<S<i64>>,
+    pub panel_lengths: Option<S<Vec<f64>>>,
+    pub hub: Option<S<RawMotion>>,
+    pub latching: Option<S<RawLatching>>,
+    pub end_time: Option<S<f64>>,
+    pub output_rate: Option<S<f64>>,
+    pub tolerance: Option<S<f64>>,
+    pub panel_mass: Option<S<f64>>,
+    pub panel_inertia: Option<S<f64>>,
+    pub hinge: Option<S<RawHingeAll>>,
+    pub hinges: Option<Vec<S<RawHinge>>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHingeAll {
+    pub stiffness: Option<S<f64>>,
+    pub preload_angle: Option<S<f64>>,
+    pub damping: Option<S<f64>>,
+    pub friction: Option<S<f64>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHinge {
+    pub stiffness: Option<S<f64>>,
+    pub reference_angle: Option<S<f64>>,
+    pub damping: Option<S<f64>>,
+    pub friction: Option<S<f64>>,
+    pub latch_angle: Option<S<f64>>,
+    pub initial_angle: Option<S<f64>>,
+    pub initial_rate: Option<S<f64>>,
 }
