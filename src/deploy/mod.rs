@@ -258,11 +258,21 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
                 let b = t_start + (t_seen - t_start) * s as f64 / 8.0;
                 let gb = g(b);
                 if gb > 0.0 {
-                    let first = if swing[i].is_none() && g(a) <= 0.0 { locate(g, a, b, event_tol * b.abs().max(1.0)) } else { b };
+                    let first = if swing[i].is_none() && g(a) <= 0.0 {
+                        locate(g, a, b, event_tol * b.abs().max(1.0))
+                    } else {
+                        b
+                    };
                     let angle = step.component(h + i, b);
                     match &mut swing[i] {
                         Some(sb) => sb.min_angle = sb.min_angle.min(angle),
-                        None => swing[i] = Some(SwingBack { hinge: i + 1, first_time: first, min_angle: angle }),
+                        None => {
+                            swing[i] = Some(SwingBack {
+                                hinge: i + 1,
+                                first_time: first,
+                                min_angle: angle,
+                            })
+                        }
                     }
                 }
                 a = b;

@@ -18,7 +18,11 @@ fn latching_name(l: Latching) -> &'static str {
 pub fn deploy_warnings(d: &Deployment, r: &DeploymentResult) -> Vec<String> {
     let mut w = Vec::new();
     for s in &r.swing_back {
-        let into = if s.hinge == 1 { "the hub".to_string() } else { format!("panel {}", s.hinge - 1) };
+        let into = if s.hinge == 1 {
+            "the hub".to_string()
+        } else {
+            format!("panel {}", s.hinge - 1)
+        };
         w.push(format!(
             "panel {} swings back below its initial angle from t = {:.6} s (minimum α_{} = {:.6} rad, initial {:.6} rad): the real array would collide with {into} there (no contact model)",
             s.hinge, s.first_time, s.hinge, s.min_angle, d.chain.hinges[s.hinge - 1].initial_angle
@@ -28,9 +32,18 @@ pub fn deploy_warnings(d: &Deployment, r: &DeploymentResult) -> Vec<String> {
         let list: Vec<String> = r
             .unlatched
             .iter()
-            .map(|(h, a)| format!("hinge {h} at {a:.6} rad (latch {:.6} rad)", d.chain.hinges[h - 1].latch_angle))
+            .map(|(h, a)| {
+                format!(
+                    "hinge {h} at {a:.6} rad (latch {:.6} rad)",
+                    d.chain.hinges[h - 1].latch_angle
+                )
+            })
             .collect();
-        w.push(format!("not all hinges latched by t = {} s: {}", r.final_time, list.join(", ")));
+        w.push(format!(
+            "not all hinges latched by t = {} s: {}",
+            r.final_time,
+            list.join(", ")
+        ));
     }
     w
 }
@@ -123,7 +136,13 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
         let _ = writeln!(
             s,
             "{:>6} {:>12} {:>13} {:>13} {:>13} {:>13} {:>13}",
-            "hinge", "α [rad]", "rate before", "rate after", "S_u [N·s]", "S_v [N·s]", "M_S [N·m·s]"
+            "hinge",
+            "α [rad]",
+            "rate before",
+            "rate after",
+            "S_u [N·s]",
+            "S_v [N·s]",
+            "M_S [N·m·s]"
         );
         for i in 0..show {
             let (f, m) = e.impulses[i];
@@ -146,7 +165,11 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
     let _ = writeln!(
         s,
         "\n{} at t = {:.9} s",
-        if r.all_latched { "all hinges latched" } else { "NOT all hinges latched" },
+        if r.all_latched {
+            "all hinges latched"
+        } else {
+            "NOT all hinges latched"
+        },
         r.final_time
     );
     if let PlanarHub::Free { .. } = d.chain.hub {
@@ -167,7 +190,12 @@ fn num(v: f64) -> String {
 }
 
 /// Writes deployment.csv, events.json and plots/*.{png,svg}.
-pub fn write_deploy(dir: &mut OutputDir, name: &str, d: &Deployment, r: &DeploymentResult) -> Result<(), OutputError> {
+pub fn write_deploy(
+    dir: &mut OutputDir,
+    name: &str,
+    d: &Deployment,
+    r: &DeploymentResult,
+) -> Result<(), OutputError> {
     let n = d.chain.len();
     dir.write("events.json", deploy_json(name, d, r) + "\n")?;
     let mut c = String::from("t [s]");
@@ -212,10 +240,32 @@ pub fn write_deploy(dir: &mut OutputDir, name: &str, d: &Deployment, r: &Deploym
 
     let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
     let series = |f: &dyn Fn(&crate::deploy::Sample, usize) -> f64| -> Vec<Series> {
-        shown.iter().map(|&i| (format!("hinge {}", i + 1), r.samples.iter().map(|s| (s.t, f(s, i))).collect())).collect()
+        shown
+            .iter()
+            .map(|&i| {
+                (
+                    format!("hinge {}", i + 1),
+                    r.samples.iter().map(|s| (s.t, f(s, i))).collect(),
+                )
+            })
+            .collect()
     };
-    line_chart(dir, "angles", "opening angles", ("t [s]", "α [rad]"), &series(&|s, i| s.alpha[i]), false)?;
-    line_chart(dir, "rates", "opening rates", ("t [s]", "α̇ [rad/s]"), &series(&|s, i| s.rate[i]), false)?;
+    line_chart(
+        dir,
+        "angles",
+        "opening angles",
+        ("t [s]", "α [rad]"),
+        &series(&|s, i| s.alpha[i]),
+        false,
+    )?;
+    line_chart(
+        dir,
+        "rates",
+        "opening rates",
+        ("t [s]", "α̇ [rad/s]"),
+        &series(&|s, i| s.rate[i]),
+        false,
+    )?;
     line_chart(
         dir,
         "reactions",
@@ -227,9 +277,21 @@ pub fn write_deploy(dir: &mut OutputDir, name: &str, d: &Deployment, r: &Deploym
     let hub: Vec<Series> = ["u [m]", "v [m]", "θ [rad]"]
         .iter()
         .enumerate()
-        .map(|(k, l)| (format!("hub {l}"), r.samples.iter().map(|s| (s.t, s.hub[k])).collect()))
+        .map(|(k, l)| {
+            (
+                format!("hub {l}"),
+                r.samples.iter().map(|s| (s.t, s.hub[k])).collect(),
+            )
+        })
         .collect();
-    line_chart(dir, "hub", "hub motion in the deployment plane", ("t [s]", "u, v [m]; θ [rad]"), &hub, false)?;
+    line_chart(
+        dir,
+        "hub",
+        "hub motion in the deployment plane",
+        ("t [s]", "u, v [m]; θ [rad]"),
+        &hub,
+        false,
+    )?;
     // Snapshots: the chain at up to 9 evenly spaced sample times (and the final state).
     let m = r.samples.len();
     let picks: Vec<usize> = (0..9).map(|k| k * (m - 1) / 8).collect();
@@ -241,8 +303,18 @@ pub fn write_deploy(dir: &mut OutputDir, name: &str, d: &Deployment, r: &Deploym
         }
         last = k;
         let s = &r.samples[k];
-        snaps.push((format!("t = {:.1} s", s.t), s.hinges.iter().map(|p| (p[0], p[1])).collect()));
+        snaps.push((
+            format!("t = {:.1} s", s.t),
+            s.hinges.iter().map(|p| (p[0], p[1])).collect(),
+        ));
     }
-    line_chart(dir, "snapshots", "panel positions (hinge points joined)", ("u [m]", "v [m]"), &snaps, true)?;
+    line_chart(
+        dir,
+        "snapshots",
+        "panel positions (hinge points joined)",
+        ("u [m]", "v [m]"),
+        &snaps,
+        true,
+    )?;
     Ok(())
 }

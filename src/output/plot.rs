@@ -210,7 +210,12 @@ fn draw_chart<DB: DrawingBackend>(
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let pts = series.iter().flat_map(|s| s.1.iter());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for &(x, y) in pts {
         if x.is_finite() && y.is_finite() {
             x0 = x0.min(x);
@@ -258,7 +263,9 @@ fn draw_chart<DB: DrawingBackend>(
             .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
             .map_err(|e| e.to_string())?;
         if !name.is_empty() {
-            drawn.label(name.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+            drawn.label(name.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
+            });
         }
     }
     if series.iter().any(|s| !s.0.is_empty()) && series.len() <= 12 {
@@ -288,9 +295,21 @@ pub fn line_chart(
         let path = dir.path(&rel)?;
         let size = (1000, 600);
         let r = if ext == "png" {
-            draw_chart(BitMapBackend::new(&path, size).into_drawing_area(), title, labels, series, equal_aspect)
+            draw_chart(
+                BitMapBackend::new(&path, size).into_drawing_area(),
+                title,
+                labels,
+                series,
+                equal_aspect,
+            )
         } else {
-            draw_chart(SVGBackend::new(&path, size).into_drawing_area(), title, labels, series, equal_aspect)
+            draw_chart(
+                SVGBackend::new(&path, size).into_drawing_area(),
+                title,
+                labels,
+                series,
+                equal_aspect,
+            )
         };
         r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
     }

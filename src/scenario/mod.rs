@@ -709,7 +709,11 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(d) => Some(deployment(cx, d, &structure)?),
         None => None,
     };
-    Ok(Scenario { name, structure, deployment })
+    Ok(Scenario {
+        name,
+        structure,
+        deployment,
+    })
 }
 
 /// Default deployment settings (docs/scenario.md).
@@ -719,7 +723,12 @@ pub const DEFAULT_OUTPUT_RATE: f64 = 10.0;
 /// Default relative integration tolerance.
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 
-fn non_negative(cx: &Ctx, v: &Option<S<f64>>, default: f64, key: String) -> Result<f64, ScenarioError> {
+fn non_negative(
+    cx: &Ctx,
+    v: &Option<S<f64>>,
+    default: f64,
+    key: String,
+) -> Result<f64, ScenarioError> {
     match v {
         None => Ok(default),
         Some(x) => {
@@ -727,7 +736,11 @@ fn non_negative(cx: &Ctx, v: &Option<S<f64>>, default: f64, key: String) -> Resu
             if val.is_finite() && val >= 0.0 {
                 Ok(val)
             } else {
-                Err(cx.invalid(x.span(), key, format!("must be a non-negative finite number, got {val}")))
+                Err(cx.invalid(
+                    x.span(),
+                    key,
+                    format!("must be a non-negative finite number, got {val}"),
+                ))
             }
         }
     }
@@ -737,53 +750,98 @@ fn finite(cx: &Ctx, v: &Option<S<f64>>, default: f64, key: String) -> Result<f64
     match v {
         None => Ok(default),
         Some(x) if x.get_ref().is_finite() => Ok(*x.get_ref()),
-        Some(x) => Err(cx.invalid(x.span(), key, format!("must be finite, got {}", x.get_ref()))),
+        Some(x) => Err(cx.invalid(
+            x.span(),
+            key,
+            format!("must be finite, got {}", x.get_ref()),
+        )),
     }
 }
 
 /// Builds the deployment chain from `[deployment]` and the structure (MODEL.md §3.2).
-fn deployment(cx: &Ctx, raw: &S<RawDeployment>, st: &Structure) -> Result<Deployment, ScenarioError> {
+fn deployment(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+    st: &Structure,
+) -> Result<Deployment, ScenarioError> {
     use crate::deploy::chain::{Chain, Hinge, Panel, PlanarHub};
     use std::f64::consts::PI;
     let d = raw.get_ref();
-    let plate = st.plates.iter().find(|p| p.name == *d.plate.get_ref()).ok_or_else(|| {
-        let names: Vec<&str> = st.plates.iter().map(|p| p.name.as_str()).collect();
-        cx.invalid(
-            d.plate.span(),
-            "deployment.plate",
-            format!("no plate named \"{}\" (plates: {})", d.plate.get_ref(), if names.is_empty() { "none".to_string() } else { names.join(", ") }),
-        )
-    })?;
+    let plate = st
+        .plates
+        .iter()
+        .find(|p| p.name == *d.plate.get_ref())
+        .ok_or_else(|| {
+            let names: Vec<&str> = st.plates.iter().map(|p| p.name.as_str()).collect();
+            cx.invalid(
+                d.plate.span(),
+                "deployment.plate",
+                format!(
+                    "no plate named \"{}\" (plates: {})",
+                    d.plate.get_ref(),
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            )
+        })?;
     let lengths: Vec<f64> = match (&d.panels, &d.panel_lengths) {
         (Some(_), Some(l)) => {
-            return Err(cx.invalid(l.span(), "deployment.panel_lengths", "give either panels or panel_lengths, not both"))
+            return Err(cx.invalid(
+                l.span(),
+                "deployment.panel_lengths",
+                "give either panels or panel_lengths, not both",
+            ))
         }
         (Some(n), None) => {
             let v = *n.get_ref();
             if !(1..=1000).contains(&v) {
-                return Err(cx.invalid(n.span(), "deployment.panels", format!("must be between 1 and 1000, got {v}")));
+                return Err(cx.invalid(
+                    n.span(),
+                    "deployment.panels",
+                    format!("must be between 1 and 1000, got {v}"),
+                ));
             }
             vec![plate.length / v as f64; v as usize]
         }
         (None, Some(l)) => {
             let v = l.get_ref();
             if v.is_empty() || v.len() > 1000 {
-                return Err(cx.invalid(l.span(), "deployment.panel_lengths", format!("needs 1 to 1000 lengths, got {}", v.len())));
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!("needs 1 to 1000 lengths, got {}", v.len()),
+                ));
             }
             if let Some(bad) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
-                return Err(cx.invalid(l.span(), "deployment.panel_lengths", format!("every length must be positive and finite, got {bad}")));
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!("every length must be positive and finite, got {bad}"),
+                ));
             }
             let sum: f64 = v.iter().sum();
             if (sum - plate.length).abs() > 1e-9 * plate.length {
                 return Err(cx.invalid(
                     l.span(),
                     "deployment.panel_lengths",
-                    format!("the lengths sum to {sum} m, but the plate \"{}\" is {} m long", plate.name, plate.length),
+                    format!(
+                        "the lengths sum to {sum} m, but the plate \"{}\" is {} m long",
+                        plate.name, plate.length
+                    ),
                 ));
             }
             v.clone()
         }
-        (None, None) => return Err(cx.invalid(raw.span(), "deployment.panels", "missing: give panels or panel_lengths")),
+        (None, None) => {
+            return Err(cx.invalid(
+                raw.span(),
+                "deployment.panels",
+                "missing: give panels or panel_lengths",
+            ))
+        }
     };
     let n = lengths.len();
     let panel_mass = match &d.panel_mass {
@@ -798,34 +856,79 @@ fn deployment(cx: &Ctx, raw: &S<RawDeployment>, st: &Structure) -> Result<Deploy
         .iter()
         .map(|&l| {
             let mass = panel_mass.unwrap_or(plate.areal_density * l * plate.width);
-            Panel { length: l, mass, inertia: panel_inertia.unwrap_or(mass * l * l / 12.0) }
+            Panel {
+                length: l,
+                mass,
+                inertia: panel_inertia.unwrap_or(mass * l * l / 12.0),
+            }
         })
         .collect();
     // Hinges: [deployment.hinge] for all, [[deployment.hinges]] per hinge overriding it.
     let all = d.hinge.as_ref().map(|h| h.get_ref());
     let k_all = match all.and_then(|h| h.stiffness.as_ref()) {
-        Some(k) => Some(non_negative(cx, &Some(k.clone()), 0.0, "deployment.hinge.stiffness".into())?),
+        Some(k) => Some(non_negative(
+            cx,
+            &Some(k.clone()),
+            0.0,
+            "deployment.hinge.stiffness".into(),
+        )?),
         None => None,
     };
-    let preload = finite(cx, &all.and_then(|h| h.preload_angle.clone()), 0.0, "deployment.hinge.preload_angle".into())?;
-    let damping_all = non_negative(cx, &all.and_then(|h| h.damping.clone()), 0.0, "deployment.hinge.damping".into())?;
-    let friction_all = non_negative(cx, &all.and_then(|h| h.friction.clone()), 0.0, "deployment.hinge.friction".into())?;
+    let preload = finite(
+        cx,
+        &all.and_then(|h| h.preload_angle.clone()),
+        0.0,
+        "deployment.hinge.preload_angle".into(),
+    )?;
+    let damping_all = non_negative(
+        cx,
+        &all.and_then(|h| h.damping.clone()),
+        0.0,
+        "deployment.hinge.damping".into(),
+    )?;
+    let friction_all = non_negative(
+        cx,
+        &all.and_then(|h| h.friction.clone()),
+        0.0,
+        "deployment.hinge.friction".into(),
+    )?;
     if let Some(list) = &d.hinges {
         if list.len() != n {
             let span = list.first().map_or(raw.span(), |h| h.span());
-            return Err(cx.invalid(span, "deployment.hinges", format!("{} entries for {n} panels: give one per hinge", list.len())));
+            return Err(cx.invalid(
+                span,
+                "deployment.hinges",
+                format!("{} entries for {n} panels: give one per hinge", list.len()),
+            ));
         }
     }
     let mut hinges = Vec::with_capacity(n);
     for i in 0..n {
         let one = d.hinges.as_ref().map(|l| &l[i]);
         let r = one.map(|h| h.get_ref());
-        let key = |f: &str| if r.is_some() { format!("deployment.hinges[{i}].{f}") } else { format!("deployment.hinge.{f}") };
+        let key = |f: &str| {
+            if r.is_some() {
+                format!("deployment.hinges[{i}].{f}")
+            } else {
+                format!("deployment.hinge.{f}")
+            }
+        };
         let default_latch = if i == 0 { PI / 2.0 } else { PI };
-        let latch = finite(cx, &r.and_then(|h| h.latch_angle.clone()), default_latch, key("latch_angle"))?;
+        let latch = finite(
+            cx,
+            &r.and_then(|h| h.latch_angle.clone()),
+            default_latch,
+            key("latch_angle"),
+        )?;
         if !(latch > 0.0 && latch <= PI) {
-            let span = r.and_then(|h| h.latch_angle.as_ref()).map_or(raw.span(), |x| x.span());
-            return Err(cx.invalid(span, key("latch_angle"), format!("must lie in (0, π], got {latch}")));
+            let span = r
+                .and_then(|h| h.latch_angle.as_ref())
+                .map_or(raw.span(), |x| x.span());
+            return Err(cx.invalid(
+                span,
+                key("latch_angle"),
+                format!("must lie in (0, π], got {latch}"),
+            ));
         }
         let stiffness = match r.and_then(|h| h.stiffness.clone()) {
             Some(k) => non_negative(cx, &Some(k), 0.0, key("stiffness"))?,
@@ -837,31 +940,70 @@ fn deployment(cx: &Ctx, raw: &S<RawDeployment>, st: &Structure) -> Result<Deploy
                 )
             })?,
         };
-        let reference = finite(cx, &r.and_then(|h| h.reference_angle.clone()), latch + preload, key("reference_angle"))?;
-        let initial = finite(cx, &r.and_then(|h| h.initial_angle.clone()), 0.0, key("initial_angle"))?;
+        let reference = finite(
+            cx,
+            &r.and_then(|h| h.reference_angle.clone()),
+            latch + preload,
+            key("reference_angle"),
+        )?;
+        let initial = finite(
+            cx,
+            &r.and_then(|h| h.initial_angle.clone()),
+            0.0,
+            key("initial_angle"),
+        )?;
         if initial >= latch {
-            let span = r.and_then(|h| h.initial_angle.as_ref()).map_or(raw.span(), |x| x.span());
-            return Err(cx.invalid(span, key("initial_angle"), format!("{initial} rad is not below the latch angle {latch} rad")));
+            let span = r
+                .and_then(|h| h.initial_angle.as_ref())
+                .map_or(raw.span(), |x| x.span());
+            return Err(cx.invalid(
+                span,
+                key("initial_angle"),
+                format!("{initial} rad is not below the latch angle {latch} rad"),
+            ));
         }
         hinges.push(Hinge {
             stiffness,
             reference_angle: reference,
-            damping: non_negative(cx, &r.and_then(|h| h.damping.clone()), damping_all, key("damping"))?,
-            friction: non_negative(cx, &r.and_then(|h| h.friction.clone()), friction_all, key("friction"))?,
+            damping: non_negative(
+                cx,
+                &r.and_then(|h| h.damping.clone()),
+                damping_all,
+                key("damping"),
+            )?,
+            friction: non_negative(
+                cx,
+                &r.and_then(|h| h.friction.clone()),
+                friction_all,
+                key("friction"),
+            )?,
             latch_angle: latch,
             initial_angle: initial,
-            initial_rate: finite(cx, &r.and_then(|h| h.initial_rate.clone()), 0.0, key("initial_rate"))?,
+            initial_rate: finite(
+                cx,
+                &r.and_then(|h| h.initial_rate.clone()),
+                0.0,
+                key("initial_rate"),
+            )?,
         });
     }
     let hub = match d.hub.as_ref().map(|h| *h.get_ref()) {
         None | Some(RawMotion::Fixed) => PlanarHub::Fixed,
         Some(RawMotion::Free) => {
             let w = plate.width_axis();
-            PlanarHub::Free { mass: st.hub.mass, inertia: st.hub.inertia.apply(w).dot(w) }
+            PlanarHub::Free {
+                mass: st.hub.mass,
+                inertia: st.hub.inertia.apply(w).dot(w),
+            }
         }
     };
     let arm = st.attachment_point(&plate.attachment) - st.hub.center_of_mass;
-    let chain = Chain { panels, hinges, hub, root: [arm.dot(plate.length_axis), arm.dot(plate.normal)] };
+    let chain = Chain {
+        panels,
+        hinges,
+        hub,
+        root: [arm.dot(plate.length_axis), arm.dot(plate.normal)],
+    };
     let pos = |v: &Option<S<f64>>, default: f64, key: &str| -> Result<f64, ScenarioError> {
         match v {
             Some(x) => cx.positive(x, key),
@@ -871,7 +1013,11 @@ fn deployment(cx: &Ctx, raw: &S<RawDeployment>, st: &Structure) -> Result<Deploy
     let tolerance = pos(&d.tolerance, DEFAULT_TOLERANCE, "deployment.tolerance")?;
     if tolerance > 1e-3 {
         let span = d.tolerance.as_ref().map_or(raw.span(), |x| x.span());
-        return Err(cx.invalid(span, "deployment.tolerance", format!("must be at most 1e-3, got {tolerance}")));
+        return Err(cx.invalid(
+            span,
+            "deployment.tolerance",
+            format!("must be at most 1e-3, got {tolerance}"),
+        ));
     }
     Ok(Deployment {
         plate: plate.name.clone(),
@@ -881,7 +1027,11 @@ fn deployment(cx: &Ctx, raw: &S<RawDeployment>, st: &Structure) -> Result<Deploy
             _ => Latching::Sequential,
         },
         end_time: pos(&d.end_time, DEFAULT_END_TIME, "deployment.end_time")?,
-        output_rate: pos(&d.output_rate, DEFAULT_OUTPUT_RATE, "deployment.output_rate")?,
+        output_rate: pos(
+            &d.output_rate,
+            DEFAULT_OUTPUT_RATE,
+            "deployment.output_rate",
+        )?,
         tolerance,
     })
 }

@@ -203,8 +203,19 @@ fn bad_input_is_refused_with_location_key_reason_and_exit_2_and_no_output() {
         let file = dir.join("scenario.toml");
         std::fs::write(&file, src.replacen(from, to, 1)).unwrap();
         let out = dir.join("out");
+        let sub = if name.contains("panel")
+            || name.contains("stiffness")
+            || name.contains("damping")
+            || name.contains("latch")
+            || name.contains("initial")
+            || name.contains("deploy")
+        {
+            "deploy"
+        } else {
+            "modes"
+        };
         let r = bin()
-            .arg("modes")
+            .arg(sub)
             .arg(&file)
             .arg("--out")
             .arg(&out)
@@ -325,4 +336,92 @@ fn help_states_si_units() {
         let s = String::from_utf8_lossy(&r.stdout);
         assert!(s.contains("SI"), "{args:?}: {s}");
     }
+}
+
+#[test]
+fn deploy_writes_complete_reproducible_outputs_and_json_interface() {
+    let dir = scratch("deploy");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed.toml");
+    for run in ["a", "b"] {
+        let r = bin()
+            .arg("deploy")
+            .arg(&scenario)
+            .arg("--out")
+            .arg(dir.join(run))
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    }
+    for f in [
+        "deployment.csv",
+        "events.json",
+        "plots/angles.png",
+        "plots/rates.svg",
+        "plots/reactions.png",
+        "plots/hub.png",
+        "plots/snapshots.svg",
+    ] {
+        let a = std::fs::read(dir.join("a").join(f)).unwrap_or_else(|_| panic!("{f} missing"));
+        assert_eq!(
+            a,
+            std::fs::read(dir.join("b").join(f)).unwrap(),
+            "{f} differs"
+        );
+    }
+    let csv = std::fs::read_to_string(dir.join("a/deployment.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    for col in [
+        "t [s]",
+        "alpha_3 [rad]",
+        "rate_1 [rad/s]",
+        "hub_u [m]",
+        "hub_theta [rad]",
+        "reaction_u_1 [N]",
+        "reaction_v_3 [N]",
+    ] {
+        assert!(header.contains(col), "{col}");
+    }
+    let r = bin()
+        .arg("deploy")
+        .arg(&scenario)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(v["all_latched"], serde_json::Value::Bool(true));
+    let latches = v["latches"].as_array().unwrap();
+    assert_eq!(latches.len(), 3);
+    for l in latches {
+        assert_eq!(l["hinge_impulses"].as_array().unwrap().len(), 3);
+        assert!(l["energy_before"].as_f64().unwrap() >= l["energy_after"].as_f64().unwrap());
+        assert_eq!(l["angles"].as_array().unwrap().len(), 3);
+    }
+    // A scenario without [deployment] is refused with exit status 2.
+    let plate = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/cantilever_plate.toml");
+    let r = bin().arg("deploy").arg(&plate).output().unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_array_that_cannot_latch_is_reported_not_hung() {
+    let dir = scratch("nolatch");
+    let file = dir.join("weak.toml");
+    // Springs whose neutral angle is short of the latch angle: the panels stop short.
+    let src = SEED
+        .replace("preload_angle = 0.25", "preload_angle = -1.0")
+        .replace("stiffness = 12.0", "stiffness = 4.0");
+    std::fs::write(&file, src.replace("end_time = 300.0", "end_time = 60.0")).unwrap();
+    let r = bin()
+        .arg("deploy")
+        .arg(&file)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(v["all_latched"], serde_json::Value::Bool(false));
+    assert!(!v["unlatched"].as_array().unwrap().is_empty());
+    assert!((v["final_time"].as_f64().unwrap() - 60.0).abs() < 1e-9);
+    let _ = std::fs::remove_dir_all(&dir);
 }
