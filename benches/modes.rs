@@ -51,5 +51,30 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// Deployment of the seed example until all latched, and N-panel chains (fixed hub, equal
+/// springs) for the cost-versus-N figure.
+fn bench_deploy(c: &mut Criterion) {
+    let mut g = c.benchmark_group("deploy");
+    g.sample_size(10);
+    let s = Scenario::from_toml_str(SEED, "seed.toml").expect("seed");
+    let d = s.deployment.clone().expect("seed has [deployment]");
+    g.bench_function("seed (3 panels) until all latched", |b| {
+        b.iter(|| black_box(flexcraft::deploy::simulate(black_box(&d))))
+    });
+    for n in [5usize, 10, 20, 50] {
+        let src = SEED.replace("panels = 3", &format!("panels = {n}")).replace(
+            "[[deployment.hinges]]          # hinge 1, at the wing root\nstiffness = 12.0\n[[deployment.hinges]]          # hinge 2: the common values above\n[[deployment.hinges]]          # hinge 3\n",
+            "",
+        );
+        let s = Scenario::from_toml_str(&src, "seed.toml").expect("seed N");
+        let mut d = s.deployment.clone().expect("deployment");
+        d.end_time = 20.0;
+        g.bench_function(format!("{n} panels, 20 s"), |b| {
+            b.iter(|| black_box(flexcraft::deploy::simulate(black_box(&d))))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_deploy);
 criterion_main!(benches);
