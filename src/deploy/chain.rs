@@ -278,10 +278,11 @@ impl Chain {
     /// The mass matrix M(q) (row-major, dof × dof).
     pub fn mass_matrix(&self, q: &[f64]) -> Mat<f64> {
         let cfg = self.configuration(q);
-        self.mass_matrix_at(&cfg)
+        let jcs: Vec<Vec<P2>> = (0..self.len()).map(|i| self.jacobian(&cfg, i)).collect();
+        self.mass_matrix_at(&jcs)
     }
 
-    fn mass_matrix_at(&self, cfg: &Configuration) -> Mat<f64> {
+    fn mass_matrix_at(&self, jcs: &[Vec<P2>]) -> Mat<f64> {
         let n = self.dof();
         let h = self.hub_dof();
         let mut m = Mat::<f64>::zeros(n, n);
@@ -291,12 +292,23 @@ impl Chain {
             m[(2, 2)] += inertia;
         }
         for (i, p) in self.panels.iter().enumerate() {
-            let jc = self.jacobian(cfg, i);
-            let ja = self.angle_jacobian(i);
+            let jc = &jcs[i];
+            // ∂φ_i/∂q: 1 for θ, d_k for α_k (k ≤ i).
+            let ja = |a: usize| {
+                if a < h {
+                    if a == 2 {
+                        1.0
+                    } else {
+                        0.0
+                    }
+                } else {
+                    Self::d(a - h)
+                }
+            };
             let cols = h + i + 1;
             for a in 0..cols {
                 for b in 0..=a {
-                    let v = p.mass * dot(jc[a], jc[b]) + p.inertia * ja[a] * ja[b];
+                    let v = p.mass * dot(jc[a], jc[b]) + p.inertia * ja(a) * ja(b);
                     m[(a, b)] += v;
                     if a != b {
                         m[(b, a)] += v;
@@ -332,18 +344,24 @@ impl Chain {
     /// Accelerations and hinge loads with the coordinates flagged in `free` free and the
     /// others locked (their rates must be zero).
     pub fn dynamics(&self, q: &[f64], qd: &[f64], free: &[bool]) -> Dynamics {
+        self.solve_dynamics(q, qd, free, true)
+    }
+
+    /// As [`Chain::dynamics`], the hinge loads only when `loads` (the integrator needs q̈ only).
+    pub fn solve_dynamics(&self, q: &[f64], qd: &[f64], free: &[bool], loads: bool) -> Dynamics {
         let n = self.dof();
         let h = self.hub_dof();
         let cfg = self.configuration(q);
         let w = self.phi_rates(qd);
-        let m = self.mass_matrix_at(&cfg);
+        let jcs: Vec<Vec<P2>> = (0..self.len()).map(|i| self.jacobian(&cfg, i)).collect();
+        let m = self.mass_matrix_at(&jcs);
         let gam = self.gamma(&cfg, qd, &w);
         let mut rhs = vec![0.0; n];
         for (i, hg) in self.hinges.iter().enumerate() {
             rhs[h + i] = hg.moment(q[h + i], qd[h + i]);
         }
         for (i, p) in self.panels.iter().enumerate() {
-            let jc = self.jacobian(&cfg, i);
+            let jc = &jcs[i];
             for (a, r) in rhs.iter_mut().enumerate().take(h + i + 1) {
                 *r -= p.mass * dot(jc[a], gam[i]);
             }
@@ -361,11 +379,18 @@ impl Chain {
                 qdd[i] = x[(a, 0)];
             }
         }
+        if !loads {
+            return Dynamics {
+                qdd,
+                force: Vec::new(),
+                moment: Vec::new(),
+            };
+        }
         // Body accelerations and Newton–Euler on the outboard sub-chains.
         let mut cdd = Vec::with_capacity(self.len());
         let mut wd = Vec::with_capacity(self.len());
         for i in 0..self.len() {
-            let jc = self.jacobian(&cfg, i);
+            let jc = &jcs[i];
             let ja = self.angle_jacobian(i);
             let mut a = gam[i];
             let mut al = 0.0;

@@ -127,7 +127,9 @@ struct System<'a> {
 impl OdeSystem for System<'_> {
     fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
         let n = self.chain.dof();
-        let d = self.chain.dynamics(&y[..n], &y[n..], &self.free);
+        let d = self
+            .chain
+            .solve_dynamics(&y[..n], &y[n..], &self.free, false);
         for i in 0..n {
             dy[i] = if self.free[i] { y[n + i] } else { 0.0 };
             dy[n + i] = d.qdd[i];
