@@ -8,6 +8,25 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
 
+/// Draws one picture into `<stem>.png` and `<stem>.svg` of the output directory: the body
+/// runs once per back end with `$root` bound to its drawing area.
+macro_rules! png_and_svg {
+    ($dir:expr, $stem:expr, $size:expr, |$root:ident| $body:expr) => {{
+        for ext in ["png", "svg"] {
+            let rel = format!("{}.{ext}", $stem);
+            let path = $dir.path(&rel)?;
+            let r = if ext == "png" {
+                let $root = BitMapBackend::new(&path, $size).into_drawing_area();
+                $body
+            } else {
+                let $root = SVGBackend::new(&path, $size).into_drawing_area();
+                $body
+            };
+            r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
+        }
+    }};
+}
+
 static FONT: Once = Once::new();
 
 /// Registers the bundled font as "sans-serif" (once per process).
@@ -165,25 +184,8 @@ fn draw_mode<DB: DrawingBackend>(
 /// (blue, exaggerated) structure.
 pub fn mode_shape(dir: &mut OutputDir, model: &RitzModel, mode: &Mode) -> Result<(), OutputError> {
     register_font();
-    for ext in ["png", "svg"] {
-        let rel = format!("plots/mode_{:03}.{ext}", mode.number);
-        let path = dir.path(&rel)?;
-        let size = (1200, 640);
-        let r = if ext == "png" {
-            draw_mode(
-                BitMapBackend::new(&path, size).into_drawing_area(),
-                model,
-                mode,
-            )
-        } else {
-            draw_mode(
-                SVGBackend::new(&path, size).into_drawing_area(),
-                model,
-                mode,
-            )
-        };
-        r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
-    }
+    let stem = format!("plots/mode_{:03}", mode.number);
+    png_and_svg!(dir, stem, (1200, 640), |root| draw_mode(root, model, mode));
     Ok(())
 }
 
@@ -290,28 +292,11 @@ pub fn line_chart(
     equal_aspect: bool,
 ) -> Result<(), OutputError> {
     register_font();
-    for ext in ["png", "svg"] {
-        let rel = format!("plots/{stem}.{ext}");
-        let path = dir.path(&rel)?;
-        let size = (1000, 600);
-        let r = if ext == "png" {
-            draw_chart(
-                BitMapBackend::new(&path, size).into_drawing_area(),
-                title,
-                labels,
-                series,
-                equal_aspect,
-            )
-        } else {
-            draw_chart(
-                SVGBackend::new(&path, size).into_drawing_area(),
-                title,
-                labels,
-                series,
-                equal_aspect,
-            )
-        };
-        r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
-    }
+    png_and_svg!(
+        dir,
+        format!("plots/{stem}"),
+        (1000, 600),
+        |root| draw_chart(root, title, labels, series, equal_aspect)
+    );
     Ok(())
 }
