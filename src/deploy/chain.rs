@@ -371,12 +371,16 @@ impl Chain {
         if !idx.is_empty() {
             let mf = Mat::from_fn(idx.len(), idx.len(), |a, b| m[(idx[a], idx[b])]);
             let mut x = Mat::from_fn(idx.len(), 1, |a, _| rhs[idx[a]]);
-            let llt = mf
-                .llt(Side::Lower)
-                .expect("the chain's mass matrix is positive definite");
-            faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-            for (a, &i) in idx.iter().enumerate() {
-                qdd[i] = x[(a, 0)];
+            // M is positive definite for positive masses; a non-finite state (a diverged
+            // integration) makes the factorisation fail: propagate NaN, the run stops.
+            match mf.llt(Side::Lower) {
+                Ok(llt) => {
+                    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
+                    for (a, &i) in idx.iter().enumerate() {
+                        qdd[i] = x[(a, 0)];
+                    }
+                }
+                Err(_) => qdd.iter_mut().for_each(|v| *v = f64::NAN),
             }
         }
         if !loads {
@@ -489,12 +493,14 @@ impl Chain {
             let mut x = Mat::from_fn(idx.len(), 1, |a, _| {
                 (0..n).map(|j| m[(idx[a], j)] * qd[j]).sum::<f64>()
             });
-            let llt = mf
-                .llt(Side::Lower)
-                .expect("the chain's mass matrix is positive definite");
-            faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-            for (a, &i) in idx.iter().enumerate() {
-                qd_new[i] = x[(a, 0)];
+            match mf.llt(Side::Lower) {
+                Ok(llt) => {
+                    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
+                    for (a, &i) in idx.iter().enumerate() {
+                        qd_new[i] = x[(a, 0)];
+                    }
+                }
+                Err(_) => qd_new.iter_mut().for_each(|v| *v = f64::NAN),
             }
         }
         let cfg = self.configuration(q);

@@ -117,6 +117,8 @@ pub struct DeploymentResult {
     pub swing_back: Vec<SwingBack>,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
+    /// The integration produced a non-finite state and was stopped there.
+    pub diverged: bool,
 }
 
 struct System<'a> {
@@ -183,6 +185,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
     let event_tol = 1e-12;
     let mut buf = vec![0.0; 2 * n];
     let mut steps = 0usize;
+    let mut diverged = false;
     let max_steps = 50_000_000usize;
 
     let check_swing = |swing: &mut Vec<Option<SwingBack>>, t: f64, alpha: &[f64]| {
@@ -208,6 +211,12 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         let t_start = t;
         let y_start = y.clone();
         let step: DenseStep = solver.step(&sys, &mut t, &mut y, d.end_time);
+        if !y.iter().all(|v| v.is_finite()) {
+            y.copy_from_slice(&y_start);
+            t = t_start;
+            diverged = true;
+            break;
+        }
         // The earliest latch crossing in this step.
         let mut event: Option<(f64, usize)> = None;
         for j in 0..nh {
@@ -343,5 +352,6 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         unlatched,
         swing_back: swing.into_iter().flatten().collect(),
         evaluations: solver.evaluations,
+        diverged,
     }
 }

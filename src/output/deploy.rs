@@ -28,6 +28,12 @@ pub fn deploy_warnings(d: &Deployment, r: &DeploymentResult) -> Vec<String> {
             s.hinge, s.first_time, s.hinge, s.min_angle, d.chain.hinges[s.hinge - 1].initial_angle
         ));
     }
+    if r.diverged {
+        w.push(format!(
+            "the integration diverged (non-finite state) at t = {} s and was stopped there",
+            r.final_time
+        ));
+    }
     if !r.all_latched {
         let list: Vec<String> = r
             .unlatched
