@@ -92,6 +92,12 @@ fn one_panel_on_fixed_hub_matches_closed_form() {
     assert!(ev.energy_after.abs() < 1e-15);
 }
 
+/// A free hub's coordinates (or rates) followed by the opening angles (or rates): the
+/// chain's q (or q̇).
+fn coords(hub: [f64; 3], angles: &[f64]) -> Vec<f64> {
+    hub.iter().chain(angles).copied().collect()
+}
+
 fn total_energy(s: &flexcraft::deploy::Sample) -> f64 {
     s.kinetic + s.spring
 }
@@ -148,14 +154,9 @@ fn energy_lost_at_a_latch_is_the_kinetic_energy_of_the_velocity_jump() {
     let r = simulate(&deployment(c.clone(), Latching::Sequential, 1e-12));
     for ev in &r.latches {
         let s = r.samples.iter().find(|s| s.t == ev.time).unwrap();
-        let q: Vec<f64> = s.hub.iter().chain(&ev.angles).copied().collect();
-        let before: Vec<f64> = s.hub_rate.iter().chain(&ev.rates_before).copied().collect();
-        let after: Vec<f64> = ev
-            .hub_rate_after
-            .iter()
-            .chain(&ev.rates_after)
-            .copied()
-            .collect();
+        let q: Vec<f64> = coords(s.hub, &ev.angles);
+        let before: Vec<f64> = coords(s.hub_rate, &ev.rates_before);
+        let after: Vec<f64> = coords(ev.hub_rate_after, &ev.rates_after);
         let jump: Vec<f64> = before.iter().zip(&after).map(|(a, b)| a - b).collect();
         let lost = c.kinetic_energy(&q, &jump);
         assert!(lost > 0.0);
@@ -182,8 +183,8 @@ fn free_hub_conserves_linear_and_angular_momentum_across_latches() {
         * 5.0
         * 20.0;
     for s in &r.samples {
-        let q: Vec<f64> = s.hub.iter().chain(&s.alpha).copied().collect();
-        let qd: Vec<f64> = s.hub_rate.iter().chain(&s.rate).copied().collect();
+        let q: Vec<f64> = coords(s.hub, &s.alpha);
+        let qd: Vec<f64> = coords(s.hub_rate, &s.rate);
         let (p, l) = c.momentum(&q, &qd);
         assert!(
             p[0].abs() < 1e-9 * scale && p[1].abs() < 1e-9 * scale,
@@ -218,23 +219,10 @@ fn simultaneous_latching_stops_a_fixed_hub_array_and_turns_a_free_one_rigidly() 
     // After: a rigid body (hub + locked array) whose momenta equal those before (zero here),
     // i.e. the hub velocity is the one that conserves linear and angular momentum.
     let s = r.samples.iter().rev().find(|s| s.t == ev.time).unwrap();
-    let q: Vec<f64> = s.hub.iter().chain(&ev.angles).copied().collect();
-    let before: Vec<f64> = r
-        .samples
-        .iter()
-        .find(|x| x.t == ev.time)
-        .unwrap()
-        .hub_rate
-        .iter()
-        .chain(&ev.rates_before)
-        .copied()
-        .collect();
-    let after: Vec<f64> = ev
-        .hub_rate_after
-        .iter()
-        .chain(&ev.rates_after)
-        .copied()
-        .collect();
+    let q: Vec<f64> = coords(s.hub, &ev.angles);
+    let first = r.samples.iter().find(|x| x.t == ev.time).unwrap();
+    let before: Vec<f64> = coords(first.hub_rate, &ev.rates_before);
+    let after: Vec<f64> = coords(ev.hub_rate_after, &ev.rates_after);
     let (p_b, l_b) = c.momentum(&q, &before);
     let (p_a, l_a) = c.momentum(&q, &after);
     assert!((p_b[0] - p_a[0]).abs() < 1e-10 && (p_b[1] - p_a[1]).abs() < 1e-10);
