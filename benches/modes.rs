@@ -69,7 +69,7 @@ fn bench_deploy(c: &mut Criterion) {
         let s = Scenario::from_toml_str(&src, "seed.toml").expect("seed N");
         let mut d = s.deployment.clone().expect("deployment");
         d.end_time = 20.0;
-        g.bench_function(format!("{n} panels, 20 s"), |b| {
+        g.bench_function(format!("{n} panels until all latched"), |b| {
             b.iter(|| black_box(flexcraft::deploy::simulate(black_box(&d))))
         });
     }

@@ -145,6 +145,70 @@ pub struct Dynamics {
     pub moment: Vec<f64>,
 }
 
+/// Solves M_FF x_F = b_F for the coordinates flagged free (x = 0 elsewhere). M is positive
+/// definite for positive masses; a non-finite state (a diverged integration) makes the
+/// factorisation fail and gives NaN, which stops the run.
+fn solve_free(m: Mat<f64>, b: &[f64], free: &[bool]) -> Vec<f64> {
+    let n = b.len();
+    let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
+    let mut x = vec![0.0; n];
+    if idx.is_empty() {
+        return x;
+    }
+    let mf = if idx.len() == n {
+        m
+    } else {
+        Mat::from_fn(idx.len(), idx.len(), |a, c| m[(idx[a], idx[c])])
+    };
+    let mut rhs = Mat::from_fn(idx.len(), 1, |a, _| b[idx[a]]);
+    match mf.llt(Side::Lower) {
+        Ok(llt) => {
+            faer::linalg::solvers::Solve::solve_in_place(&llt, rhs.as_mut());
+            for (a, &i) in idx.iter().enumerate() {
+                x[i] = rhs[(a, 0)];
+            }
+        }
+        Err(_) => x.iter_mut().for_each(|v| *v = f64::NAN),
+    }
+    x
+}
+
+/// Sums over the panels outboard of each hinge l (i ≥ l), about the hinge point H_l:
+/// S0_l = Σ m_i, B_l = Σ m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i, accumulated
+/// tip-to-root by the parallel-axis shift (no cancellation between large absolute positions):
+///   B_l = B_{l+1} + S0_{l+1}(H_{l+1} − H_l) + m_l (C_l − H_l),
+///   A_l = A_{l+1} + 2(H_{l+1} − H_l)·B_{l+1} + S0_{l+1}|H_{l+1} − H_l|² + m_l|C_l − H_l|² + I_l.
+struct OutboardSums {
+    s0: Vec<f64>,
+    b: Vec<P2>,
+    a: Vec<f64>,
+}
+
+impl OutboardSums {
+    fn new(chain: &Chain, cfg: &Configuration) -> Self {
+        let nn = chain.len();
+        let mut s0 = vec![0.0; nn];
+        let mut b = vec![[0.0; 2]; nn];
+        let mut a = vec![0.0; nn];
+        let (mut s0n, mut bn, mut an) = (0.0, [0.0; 2], 0.0);
+        for l in (0..nn).rev() {
+            let p = &chain.panels[l];
+            let d = sub(cfg.hinges[l + 1], cfg.hinges[l]);
+            let c = sub(cfg.centres[l], cfg.hinges[l]);
+            an += 2.0 * dot(d, bn) + s0n * dot(d, d) + p.mass * dot(c, c) + p.inertia;
+            bn = [
+                bn[0] + s0n * d[0] + p.mass * c[0],
+                bn[1] + s0n * d[1] + p.mass * c[1],
+            ];
+            s0n += p.mass;
+            s0[l] = s0n;
+            b[l] = bn;
+            a[l] = an;
+        }
+        Self { s0, b, a }
+    }
+}
+
 impl Chain {
     /// Number of panels.
     pub fn len(&self) -> usize {
@@ -275,44 +339,56 @@ impl Chain {
         a
     }
 
-    /// The mass matrix M(q) (row-major, dof × dof).
+    /// The mass matrix M(q) (dof × dof).
     pub fn mass_matrix(&self, q: &[f64]) -> Mat<f64> {
         let cfg = self.configuration(q);
-        let jcs: Vec<Vec<P2>> = (0..self.len()).map(|i| self.jacobian(&cfg, i)).collect();
-        self.mass_matrix_at(&jcs)
+        self.mass_matrix_at(&cfg, &OutboardSums::new(self, &cfg))
     }
 
-    fn mass_matrix_at(&self, jcs: &[Vec<P2>]) -> Mat<f64> {
+    /// M(q) from the outboard sums, O(N²) with O(1) per entry (the Jacobian form
+    /// Σ m_i J_iᵀJ_i costs O(N³); both agree, see the unit test). Every column of a rotation
+    /// (θ about P, α_k about H_k with sign d_k) moves panel i ≥ its start as
+    /// J_i = s ẑ×(C_i − X), so for k ≤ l
+    ///   M_{α_k α_l} = d_k d_l [A_l + (H_l − H_k)·B_l],
+    ///   M_{θ α_l}   = d_l [A_l + (H_l − P)·B_l],
+    ///   M_{u α_l}   = d_l (ẑ×B_l)_u,   M_{v α_l} = d_l (ẑ×B_l)_v,
+    /// with A_l, B_l of [`OutboardSums`].
+    fn mass_matrix_at(&self, cfg: &Configuration, sums: &OutboardSums) -> Mat<f64> {
         let n = self.dof();
         let h = self.hub_dof();
+        let nn = self.len();
         let mut m = Mat::<f64>::zeros(n, n);
-        if let PlanarHub::Free { mass, inertia } = self.hub {
-            m[(0, 0)] += mass;
-            m[(1, 1)] += mass;
-            m[(2, 2)] += inertia;
+        for l in 0..nn {
+            let hl = cfg.hinges[l];
+            for k in 0..=l {
+                let v =
+                    Self::d(k) * Self::d(l) * (sums.a[l] + dot(sub(hl, cfg.hinges[k]), sums.b[l]));
+                m[(h + k, h + l)] = v;
+                m[(h + l, h + k)] = v;
+            }
         }
-        for (i, p) in self.panels.iter().enumerate() {
-            let jc = &jcs[i];
-            // ∂φ_i/∂q: 1 for θ, d_k for α_k (k ≤ i).
-            let ja = |a: usize| {
-                if a < h {
-                    if a == 2 {
-                        1.0
-                    } else {
-                        0.0
-                    }
-                } else {
-                    Self::d(a - h)
-                }
-            };
-            let cols = h + i + 1;
-            for a in 0..cols {
-                for b in 0..=a {
-                    let v = p.mass * dot(jc[a], jc[b]) + p.inertia * ja(a) * ja(b);
-                    m[(a, b)] += v;
-                    if a != b {
-                        m[(b, a)] += v;
-                    }
+        if let PlanarHub::Free { mass, inertia } = self.hub {
+            let p = cfg.hub;
+            let r = sub(cfg.hinges[0], p);
+            let b_p = [
+                sums.b[0][0] + sums.s0[0] * r[0],
+                sums.b[0][1] + sums.s0[0] * r[1],
+            ];
+            m[(0, 0)] = mass + sums.s0[0];
+            m[(1, 1)] = mass + sums.s0[0];
+            m[(2, 2)] = inertia + sums.a[0] + 2.0 * dot(r, sums.b[0]) + sums.s0[0] * dot(r, r);
+            let pb = perp(b_p);
+            m[(0, 2)] = pb[0];
+            m[(2, 0)] = pb[0];
+            m[(1, 2)] = pb[1];
+            m[(2, 1)] = pb[1];
+            for l in 0..nn {
+                let d = Self::d(l);
+                let pb = perp(sums.b[l]);
+                let t = d * (sums.a[l] + dot(sub(cfg.hinges[l], p), sums.b[l]));
+                for (row, v) in [(0, d * pb[0]), (1, d * pb[1]), (2, t)] {
+                    m[(row, h + l)] = v;
+                    m[(h + l, row)] = v;
                 }
             }
         }
@@ -353,36 +429,32 @@ impl Chain {
         let h = self.hub_dof();
         let cfg = self.configuration(q);
         let w = self.phi_rates(qd);
-        let jcs: Vec<Vec<P2>> = (0..self.len()).map(|i| self.jacobian(&cfg, i)).collect();
-        let m = self.mass_matrix_at(&jcs);
+        let sums = OutboardSums::new(self, &cfg);
+        let m = self.mass_matrix_at(&cfg, &sums);
         let gam = self.gamma(&cfg, qd, &w);
+        // Generalized forces Q − Σ_i m_i J_iᵀ γ_i through outboard sums of the panels'
+        // velocity-term forces: G_k = Σ_{i≥k} m_i γ_i and X_k = Σ_{i≥k} m_i (C_i − H_k) × γ_i,
+        // X_k = X_{k+1} + (H_{k+1} − H_k) × G_{k+1} + m_k (C_k − H_k) × γ_k.
         let mut rhs = vec![0.0; n];
         for (i, hg) in self.hinges.iter().enumerate() {
             rhs[h + i] = hg.moment(q[h + i], qd[h + i]);
         }
-        for (i, p) in self.panels.iter().enumerate() {
-            let jc = &jcs[i];
-            for (a, r) in rhs.iter_mut().enumerate().take(h + i + 1) {
-                *r -= p.mass * dot(jc[a], gam[i]);
-            }
+        let nn = self.len();
+        let mut g = [0.0; 2];
+        let mut x = 0.0;
+        for k in (0..nn).rev() {
+            let mk = self.panels[k].mass;
+            x += cross(sub(cfg.hinges[k + 1], cfg.hinges[k]), g)
+                + mk * cross(sub(cfg.centres[k], cfg.hinges[k]), gam[k]);
+            g = [g[0] + mk * gam[k][0], g[1] + mk * gam[k][1]];
+            rhs[h + k] -= Self::d(k) * x;
         }
-        let idx: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
-        let mut qdd = vec![0.0; n];
-        if !idx.is_empty() {
-            let mf = Mat::from_fn(idx.len(), idx.len(), |a, b| m[(idx[a], idx[b])]);
-            let mut x = Mat::from_fn(idx.len(), 1, |a, _| rhs[idx[a]]);
-            // M is positive definite for positive masses; a non-finite state (a diverged
-            // integration) makes the factorisation fail: propagate NaN, the run stops.
-            match mf.llt(Side::Lower) {
-                Ok(llt) => {
-                    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-                    for (a, &i) in idx.iter().enumerate() {
-                        qdd[i] = x[(a, 0)];
-                    }
-                }
-                Err(_) => qdd.iter_mut().for_each(|v| *v = f64::NAN),
-            }
+        if h == 3 {
+            rhs[0] -= g[0];
+            rhs[1] -= g[1];
+            rhs[2] -= x + cross(sub(cfg.hinges[0], cfg.hub), g);
         }
+        let qdd = solve_free(m, &rhs, free);
         if !loads {
             return Dynamics {
                 qdd,
@@ -394,7 +466,7 @@ impl Chain {
         let mut cdd = Vec::with_capacity(self.len());
         let mut wd = Vec::with_capacity(self.len());
         for i in 0..self.len() {
-            let jc = &jcs[i];
+            let jc = self.jacobian(&cfg, i);
             let ja = self.angle_jacobian(i);
             let mut a = gam[i];
             let mut al = 0.0;
@@ -406,7 +478,6 @@ impl Chain {
             cdd.push(a);
             wd.push(al);
         }
-        let nn = self.len();
         let mut force = vec![[0.0; 2]; nn];
         let mut moment = vec![0.0; nn];
         for i in 0..nn {
@@ -486,23 +557,10 @@ impl Chain {
     pub fn impact(&self, q: &[f64], qd: &[f64], free_after: &[bool]) -> (Vec<f64>, Vec<(P2, f64)>) {
         let n = self.dof();
         let m = self.mass_matrix(q);
-        let idx: Vec<usize> = (0..n).filter(|&i| free_after[i]).collect();
-        let mut qd_new = vec![0.0; n];
-        if !idx.is_empty() {
-            let mf = Mat::from_fn(idx.len(), idx.len(), |a, b| m[(idx[a], idx[b])]);
-            let mut x = Mat::from_fn(idx.len(), 1, |a, _| {
-                (0..n).map(|j| m[(idx[a], j)] * qd[j]).sum::<f64>()
-            });
-            match mf.llt(Side::Lower) {
-                Ok(llt) => {
-                    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-                    for (a, &i) in idx.iter().enumerate() {
-                        qd_new[i] = x[(a, 0)];
-                    }
-                }
-                Err(_) => qd_new.iter_mut().for_each(|v| *v = f64::NAN),
-            }
-        }
+        let p: Vec<f64> = (0..n)
+            .map(|a| (0..n).map(|j| m[(a, j)] * qd[j]).sum::<f64>())
+            .collect();
+        let qd_new = solve_free(m, &p, free_after);
         let cfg = self.configuration(q);
         let dq: Vec<f64> = (0..n).map(|i| qd_new[i] - qd[i]).collect();
         let dw = self.phi_rates(&dq);
@@ -525,5 +583,88 @@ impl Chain {
             })
             .collect();
         (qd_new, impulses)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The textbook form M = Σ_i m_i J_iᵀJ_i + I_i a_i a_iᵀ (+ hub), O(N³).
+    fn mass_matrix_by_jacobians(chain: &Chain, q: &[f64]) -> Mat<f64> {
+        let n = chain.dof();
+        let cfg = chain.configuration(q);
+        let mut m = Mat::<f64>::zeros(n, n);
+        if let PlanarHub::Free { mass, inertia } = chain.hub {
+            m[(0, 0)] = mass;
+            m[(1, 1)] = mass;
+            m[(2, 2)] = inertia;
+        }
+        for (i, p) in chain.panels.iter().enumerate() {
+            let jc = chain.jacobian(&cfg, i);
+            let ja = chain.angle_jacobian(i);
+            for a in 0..n {
+                for b in 0..n {
+                    m[(a, b)] += p.mass * dot(jc[a], jc[b]) + p.inertia * ja[a] * ja[b];
+                }
+            }
+        }
+        m
+    }
+
+    fn chain(n: usize, hub: PlanarHub) -> Chain {
+        let panels = (0..n)
+            .map(|i| {
+                let l = 1.0 + 0.1 * i as f64;
+                let m = 2.0 + 0.3 * i as f64;
+                Panel {
+                    length: l,
+                    mass: m,
+                    inertia: m * l * l / 12.0 + 0.01,
+                }
+            })
+            .collect();
+        let hinge = Hinge {
+            stiffness: 1.0,
+            reference_angle: 3.0,
+            damping: 0.0,
+            friction: 0.0,
+            latch_angle: PI,
+            initial_angle: 0.0,
+            initial_rate: 0.0,
+        };
+        Chain {
+            panels,
+            hinges: vec![hinge; n],
+            hub,
+            root: [0.7, -0.4],
+        }
+    }
+
+    #[test]
+    fn outboard_sums_give_the_jacobian_mass_matrix() {
+        for hub in [
+            PlanarHub::Fixed,
+            PlanarHub::Free {
+                mass: 50.0,
+                inertia: 20.0,
+            },
+        ] {
+            let c = chain(7, hub);
+            let q: Vec<f64> = (0..c.dof()).map(|i| 0.3 + 0.37 * i as f64).collect();
+            let fast = c.mass_matrix(&q);
+            let slow = mass_matrix_by_jacobians(&c, &q);
+            for a in 0..c.dof() {
+                for b in 0..c.dof() {
+                    let scale = slow[(a, a)].abs().max(slow[(b, b)].abs());
+                    assert!(
+                        (fast[(a, b)] - slow[(a, b)]).abs() <= 1e-13 * scale,
+                        "M[{a},{b}] {} vs {}",
+                        fast[(a, b)],
+                        slow[(a, b)]
+                    );
+                }
+            }
+        }
     }
 }
