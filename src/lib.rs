@@ -18,8 +18,10 @@ pub mod basis;
 pub mod deploy;
 pub mod math;
 pub mod output;
+pub mod response;
 pub mod ritz;
 pub mod scenario;
+pub mod simulation;
 pub mod structure;
 
 pub use ritz::{ModalAnalysis, RitzModel};

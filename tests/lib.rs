@@ -14,4 +14,5 @@ mod suite {
     pub mod modal_properties;
     pub mod mutations;
     pub mod plates;
+    pub mod response;
 }

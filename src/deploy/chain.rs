@@ -298,7 +298,7 @@ impl Chain {
     }
 
     /// Absolute angular rates φ̇_i.
-    fn phi_rates(&self, qd: &[f64]) -> Vec<f64> {
+    pub fn phi_rates(&self, qd: &[f64]) -> Vec<f64> {
         let h = self.hub_dof();
         let mut w = if h == 3 { qd[2] } else { 0.0 };
         (0..self.len())
@@ -538,6 +538,27 @@ impl Chain {
             l += pn.mass * cross(cfg.centres[i], v) + pn.inertia * w[i];
         }
         (p, l)
+    }
+
+    /// Velocities of the hinge points H_1..H_N: V_{H₁} = V_P + θ̇ ẑ × (H₁ − P),
+    /// V_{H_{i+1}} = V_{H_i} + φ̇_i ẑ × l_i e(φ_i). A point of panel i at distance s from its
+    /// hinge moves with V_{H_i} + φ̇_i ẑ × s e(φ_i).
+    pub fn hinge_velocities(&self, cfg: &Configuration, qd: &[f64]) -> Vec<P2> {
+        let h = self.hub_dof();
+        let w = self.phi_rates(qd);
+        let mut v = if h == 3 {
+            let r = perp(sub(cfg.hinges[0], cfg.hub));
+            [qd[0] + qd[2] * r[0], qd[1] + qd[2] * r[1]]
+        } else {
+            [0.0; 2]
+        };
+        let mut out = Vec::with_capacity(self.len());
+        for (i, p) in self.panels.iter().enumerate() {
+            out.push(v);
+            let d = perp(e(cfg.phi[i]));
+            v = [v[0] + w[i] * p.length * d[0], v[1] + w[i] * p.length * d[1]];
+        }
+        out
     }
 
     fn centre_velocity(&self, cfg: &Configuration, i: usize, qd: &[f64]) -> P2 {

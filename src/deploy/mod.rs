@@ -83,6 +83,10 @@ pub struct LatchEvent {
     pub impulses: Vec<(P2, f64)>,
     /// Hub velocity after (u̇, v̇, θ̇) for a free hub.
     pub hub_rate_after: [f64; 3],
+    /// Every coordinate at the event (the chain's q: hub's u, v, θ when free, then α).
+    pub q: Vec<f64>,
+    /// Every rate just before the impact.
+    pub qd_before: Vec<f64>,
 }
 
 /// A panel that swung back below its initial angle: the real array would collide there.
@@ -308,6 +312,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
                     .map(|i| i + 1)
                     .collect();
                 let rates_before = qd[h..].to_vec();
+                let qd_before = qd.to_vec();
                 let energy_before = chain.kinetic_energy(q, qd);
                 let q = q.to_vec();
                 y[n..].copy_from_slice(&qd_new);
@@ -328,6 +333,8 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
                     } else {
                         [0.0; 3]
                     },
+                    q: q.clone(),
+                    qd_before,
                 });
                 if samples.last().is_none_or(|s| s.t < te) {
                     samples.push(before);

@@ -9,6 +9,7 @@ pub use error::{ErrorKind, Location, ScenarioError};
 
 use crate::deploy::{Deployment, Latching};
 use crate::math::Vec3;
+use crate::response::{HandoverMethod, ResponseSettings};
 use crate::structure::{
     inertia_tensor, Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass,
     Material, Plate, PlateTerms, Structure, StructureError,
@@ -26,6 +27,8 @@ pub struct Scenario {
     pub structure: Structure,
     /// The deployment problem, when the file has a `[deployment]` section.
     pub deployment: Option<Deployment>,
+    /// The `[response]` settings (defaults when the section is absent).
+    pub response: ResponseSettings,
 }
 
 /// Default number of Ritz functions (bending, torsion, axial) of a beam.
@@ -709,10 +712,86 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(d) => Some(deployment(cx, d, &structure)?),
         None => None,
     };
+    let response = match &raw.response {
+        Some(r) => response(cx, r)?,
+        None => ResponseSettings::default(),
+    };
     Ok(Scenario {
         name,
         structure,
         deployment,
+        response,
+    })
+}
+
+/// `[response]` (docs/scenario.md): duration > 0, output_rate > 0 with at most
+/// [`crate::response::MAX_ROWS`] samples, modes ≥ 1 (clamped later to the model's count,
+/// with a warning), 0 ≤ damping_ratio < 1.
+fn response(cx: &Ctx, r: &S<RawResponse>) -> Result<ResponseSettings, ScenarioError> {
+    let d = ResponseSettings::default();
+    let rr = r.get_ref();
+    let duration = match &rr.duration {
+        Some(v) => cx.positive(v, "response.duration")?,
+        None => d.duration,
+    };
+    let output_rate = match &rr.output_rate {
+        Some(v) => cx.positive(v, "response.output_rate")?,
+        None => d.output_rate,
+    };
+    let rows = crate::response::rows(duration, output_rate);
+    if rows > crate::response::MAX_ROWS {
+        let span = rr
+            .output_rate
+            .as_ref()
+            .or(rr.duration.as_ref())
+            .map_or(r.span(), |v| v.span());
+        return Err(cx.invalid(
+            span,
+            "response.output_rate",
+            format!(
+                "{duration} s at {output_rate} Hz would write {rows} rows; the limit is {} \
+                 (lower output_rate or duration)",
+                crate::response::MAX_ROWS
+            ),
+        ));
+    }
+    let modes = match &rr.modes {
+        None => None,
+        Some(m) => {
+            let k = *m.get_ref();
+            if k < 1 {
+                return Err(cx.invalid(
+                    m.span(),
+                    "response.modes",
+                    format!("must be at least 1 (elastic modes kept), got {k}"),
+                ));
+            }
+            Some(k as usize)
+        }
+    };
+    let damping_ratio = non_negative(
+        cx,
+        &rr.damping_ratio,
+        d.damping_ratio,
+        "response.damping_ratio".into(),
+    )?;
+    if damping_ratio >= 1.0 {
+        let span = rr.damping_ratio.as_ref().map_or(r.span(), |v| v.span());
+        return Err(cx.invalid(
+            span,
+            "response.damping_ratio",
+            format!("must be below 1 (an underdamped structure), got {damping_ratio}"),
+        ));
+    }
+    Ok(ResponseSettings {
+        duration,
+        output_rate,
+        modes,
+        damping_ratio,
+        handover: match rr.handover.as_ref().map(|h| *h.get_ref()) {
+            Some(RawHandover::Impulse) => HandoverMethod::Impulse,
+            _ => HandoverMethod::Projection,
+        },
     })
 }
 

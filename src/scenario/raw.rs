@@ -24,6 +24,7 @@ pub struct RawScenario {
     pub masses: Vec<S<RawMass>>,
     pub ritz: Option<S<RawRitz>>,
     pub deployment: Option<S<RawDeployment>>,
+    pub response: Option<S<RawResponse>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -200,4 +201,21 @@ pub struct RawHinge {
     pub latch_angle: Option<S<f64>>,
     pub initial_angle: Option<S<f64>>,
     pub initial_rate: Option<S<f64>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawHandover {
+    Projection,
+    Impulse,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawResponse {
+    pub duration: Option<S<f64>>,
+    pub output_rate: Option<S<f64>>,
+    pub modes: Option<S<i64>>,
+    pub damping_ratio: Option<S<f64>>,
+    pub handover: Option<S<RawHandover>>,
 }

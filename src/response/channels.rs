@@ -1,0 +1,138 @@
+//! The physical quantities recorded during the response, each linear in the generalized
+//! coordinates (a row c with value c·q): the paper's figures 2.4–2.7.
+//!
+//! * every beam's tip: elastic deflection in its two bending planes (v along the section's
+//!   y axis, w along z) and twist θ, relative to its root section (fig. 2.4 for the mast);
+//! * every plate's two tip corners (x = a, y = ∓b/2): elastic deflection W along the normal,
+//!   relative to its root yoke (fig. 2.5);
+//! * the hub: translation of its centre of mass along the structure axes (fig. 2.6) and its
+//!   small rotation about them (fig. 2.7).
+
+use crate::ritz::assembly::ElementBasis;
+use crate::ritz::RitzModel;
+use crate::structure::ComponentId;
+
+/// What a channel measures.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ChannelKind {
+    /// A beam tip's elastic deflection (m) or twist (rad).
+    BeamTip {
+        /// Beam name.
+        beam: String,
+    },
+    /// A plate tip corner's elastic deflection (m).
+    PlateTip {
+        /// Plate name.
+        plate: String,
+    },
+    /// Hub translation, m.
+    HubTranslation,
+    /// Hub rotation, rad.
+    HubRotation,
+}
+
+/// One recorded quantity.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Channel {
+    /// Column name (CSV header), e.g. `mast_tip_v`.
+    pub name: String,
+    /// Human label, e.g. "mast tip deflection v".
+    pub label: String,
+    /// SI unit.
+    pub unit: &'static str,
+    /// Group.
+    pub kind: ChannelKind,
+    /// The row c: value = c · q.
+    pub row: Vec<f64>,
+}
+
+/// The standard channels of a model: beams' tips, plates' tip corners, the hub.
+pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
+    let n = model.dof();
+    let st = &model.structure;
+    let mut out = Vec::new();
+    for e in &model.elements {
+        match (&e.id, &e.basis) {
+            (
+                ComponentId::Beam(i),
+                ElementBasis::Beam {
+                    bending, torsion, ..
+                },
+            ) => {
+                let name = &st.beams[*i].name;
+                let xb = bending.eval_vec(1.0);
+                let xt = torsion.eval_vec(1.0);
+                for (field, label, unit, values) in [
+                    (1usize, "v", "m", &xb),
+                    (2, "w", "m", &xb),
+                    (3, "twist", "rad", &xt),
+                ] {
+                    let f = &e.fields[field];
+                    let mut row = vec![0.0; n];
+                    for k in 0..f.len {
+                        row[f.start + k] = values[k][0];
+                    }
+                    out.push(Channel {
+                        name: format!("{name}_tip_{label}"),
+                        label: if unit == "m" {
+                            format!("{name} tip deflection {label}")
+                        } else {
+                            format!("{name} tip twist")
+                        },
+                        unit,
+                        kind: ChannelKind::BeamTip { beam: name.clone() },
+                        row,
+                    });
+                }
+            }
+            (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
+                let name = &st.plates[*i].name;
+                let xv = length.eval_vec(1.0);
+                let ny = width.len();
+                let start = e.own_range().start;
+                for (eta, side, sign) in [(0.0, "minus", "−"), (1.0, "plus", "+")] {
+                    let yv = width.eval_vec(eta);
+                    let mut row = vec![0.0; n];
+                    for (m, x) in xv.iter().enumerate() {
+                        for (k, y) in yv.iter().enumerate() {
+                            row[start + m * ny + k] = x[0] * y[0];
+                        }
+                    }
+                    out.push(Channel {
+                        name: format!("{name}_tip_{side}"),
+                        label: format!("{name} tip corner y = {sign}b/2"),
+                        unit: "m",
+                        kind: ChannelKind::PlateTip {
+                            plate: name.clone(),
+                        },
+                        row,
+                    });
+                }
+            }
+            _ => {}
+        }
+    }
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let mut row = vec![0.0; n];
+        row[k] = 1.0;
+        out.push(Channel {
+            name: format!("hub_{axis}"),
+            label: format!("hub translation {axis}"),
+            unit: "m",
+            kind: ChannelKind::HubTranslation,
+            row,
+        });
+    }
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        let mut row = vec![0.0; n];
+        row[3 + k] = 1.0;
+        out.push(Channel {
+            name: format!("hub_rot_{axis}"),
+            label: format!("hub rotation about {axis}"),
+            unit: "rad",
+            kind: ChannelKind::HubRotation,
+            row,
+        });
+    }
+    out
+}

@@ -1,0 +1,504 @@
+//! Hand-over from the deploying chain to the flexible model at the final latch
+//! (MODEL.md §3.3).
+//!
+//! *Projection* (default). Just before the final latch the velocity field v⁻ is the chain's:
+//! the hub and every component other than the deploying plate move rigidly with the hub
+//! (V at its centre of mass, Ω), and each point of panel i at distance s from its hinge moves
+//! with V_{H_i} + φ̇_i ẑ × s e(φ_i). The latch is a plastic impact after which the motion lies
+//! in the Ritz space of the deployed structure; conservation of generalized momentum gives
+//!
+//!   M q̇⁺ = b = ∫ Φᵀ ρ v⁻ dV,    η̇_j = φ_jᵀ b  (mass-normalised modes, η₀ = 0),
+//!
+//! the M-orthogonal projection of v⁻: the kinetic energy can only drop, by
+//! ½∫ρ|v⁻ − Φq̇⁺|² dV, and for a free hub the linear and angular momentum are kept exactly
+//! (rigid translations and rotations are in the Ritz space). Split v⁻ = Φ q̇_h + δv with q̇_h
+//! the hub's rigid velocity in Ritz coordinates and δv non-zero on the plate only:
+//!
+//!   b = M q̇_h + Bᵀ b_z(δv),  b_z = [∫μ δv dA; ∫μ r × δv dA; ∫μ X_m Y_n (n·δv) dA],
+//!
+//! with B = [T; P] the plate's attachment map and own-coordinate selector
+//! ([`crate::ritz::assembly`]). δv does not vary across the width, so the width integral is
+//! b·∫Y_n dη and the length integral is a Gauss rule on every panel (δv has a kink at each
+//! hinge).
+//!
+//! *Impulse* (the paper's route, (2.7)): the structure at rest receives the final latch's
+//! hinge impulses, S_i applied at the centre of panel i (the paper's Π = Σ S_i f(x_i)):
+//! b = Σ_i Φ(x_i)ᵀ S_i.
+//!
+//! Frames: the chain's deployment plane (u along the wing's length axis e_a, v along its
+//! normal n, ẑ = e_a × n) is turned by the hub's rotation θ at the latch; everything is
+//! expressed in the hub's body axes, i.e. the structure frame of the deployed model.
+
+use super::ResponseError;
+use crate::basis::{Basis1d, Quadrature};
+use crate::deploy::chain::{Chain, PlanarHub, P2};
+use crate::deploy::{Deployment, DeploymentResult, LatchEvent};
+use crate::math::Vec3;
+use crate::ritz::assembly::{Element, ElementBasis, HUB_DOF};
+use crate::ritz::{ModalAnalysis, RitzModel};
+use crate::structure::{ComponentId, HubMotion, Plate, RigidBody, Structure};
+
+/// How the deployment's motion becomes the structure's initial velocity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HandoverMethod {
+    /// Mass-weighted projection of the pre-latch velocity field (default).
+    Projection,
+    /// The paper's route: the latch impulses applied to the structure at rest.
+    Impulse,
+}
+
+impl HandoverMethod {
+    /// The scenario keyword.
+    pub fn name(self) -> &'static str {
+        match self {
+            HandoverMethod::Projection => "projection",
+            HandoverMethod::Impulse => "impulse",
+        }
+    }
+}
+
+/// Linear momentum (N·s) and angular momentum about the hub's centre of mass (N·m·s), in
+/// the structure frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Momentum {
+    /// N·s.
+    pub linear: Vec3,
+    /// N·m·s, about the hub's centre of mass.
+    pub angular: Vec3,
+}
+
+/// The result of the hand-over.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Handover {
+    /// The method used.
+    pub method: HandoverMethod,
+    /// Time of the final latch, s.
+    pub latch_time: f64,
+    /// Hinge whose latch ended the deployment (1-based).
+    pub latch_hinge: usize,
+    /// Generalized impulse b = ∫Φᵀρv⁻dV (projection) or Σ Φᵀ S (impulse), per coordinate.
+    pub generalized_impulse: Vec<f64>,
+    /// Initial modal velocities η̇_j(0) = φ_jᵀ b, one per mode of the analysis.
+    pub modal_velocity: Vec<f64>,
+    /// Generalized velocities after the hand-over, q̇⁺ = Σ_j φ_j η̇_j.
+    pub qdot: Vec<f64>,
+    /// Kinetic energy just before the final latch, from the chain's bodies and the
+    /// structure's rigid parts moving with the hub, J.
+    pub energy_before: f64,
+    /// The same from the plate's own density field (the quantity the projection conserves or
+    /// lowers; equal to `energy_before` when the panels' masses are the plate's), J.
+    pub energy_before_field: f64,
+    /// Kinetic energy after the hand-over, ½Σ η̇_j², J.
+    pub energy_after: f64,
+    /// Momentum before (chain bodies + rigid parts), structure frame.
+    pub momentum_before: Momentum,
+    /// Momentum after, rows of M q̇⁺ (a free hub's; for a fixed hub the supports take it).
+    pub momentum_after: Momentum,
+    /// Largest |α_i − latch angle_i| at the final latch, rad (non-zero only with
+    /// simultaneous latching: the hand-over still uses the straight wing).
+    pub angle_mismatch: f64,
+    /// Hub position u, v (m) and rotation θ (rad) in the deployment plane at the latch.
+    pub hub_state: [f64; 3],
+    /// Notes on choices the data forced (printed as warnings).
+    pub notes: Vec<String>,
+}
+
+/// The deploying plate's place in the model.
+struct PlateView<'a> {
+    plate: &'a Plate,
+    element: &'a Element,
+    xb: &'a dyn Basis1d,
+    yb: &'a dyn Basis1d,
+}
+
+impl<'a> PlateView<'a> {
+    fn find(model: &'a RitzModel, name: &str) -> Result<Self, ResponseError> {
+        let idx = model
+            .structure
+            .plates
+            .iter()
+            .position(|p| p.name == name)
+            .ok_or_else(|| ResponseError::UnknownPlate(name.to_string()))?;
+        let element = model
+            .element(ComponentId::Plate(idx))
+            .ok_or_else(|| ResponseError::UnknownPlate(name.to_string()))?;
+        let ElementBasis::Plate { length, width } = &element.basis else {
+            return Err(ResponseError::UnknownPlate(name.to_string()));
+        };
+        Ok(Self {
+            plate: &model.structure.plates[idx],
+            element,
+            xb: length.as_ref(),
+            yb: width.as_ref(),
+        })
+    }
+
+    /// Bᵀ [f_U; f_Θ; f_g] added into b (length n).
+    fn scatter(&self, b: &mut [f64], fu: Vec3, fth: Vec3, fg: &[f64]) {
+        let t = &self.element.attachment;
+        for (c, bc) in b.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for i in 0..3 {
+                s += t[(i, c)] * fu.get(i) + t[(3 + i, c)] * fth.get(i);
+            }
+            *bc += s;
+        }
+        let start = self.element.own_range().start;
+        for (k, v) in fg.iter().enumerate() {
+            b[start + k] += v;
+        }
+    }
+}
+
+/// The state just before the final latch, in the structure frame.
+struct PreLatch {
+    /// Hub's centre-of-mass velocity and angular velocity.
+    v_hub: Vec3,
+    w_hub: Vec3,
+    /// Per panel: start x along the wing, length, hinge velocity, angular rate (3-D vectors
+    /// in the structure frame).
+    panels: Vec<PanelMotion>,
+    theta: f64,
+    hub_state: [f64; 3],
+}
+
+struct PanelMotion {
+    start: f64,
+    length: f64,
+    mass: f64,
+    inertia: f64,
+    /// Velocity of the hinge point H_i.
+    v_hinge: Vec3,
+    /// φ̇_i ẑ × e(φ_i) in the structure frame: the velocity per metre along the panel.
+    v_per_metre: Vec3,
+    /// φ̇_i ẑ.
+    omega: Vec3,
+}
+
+impl PanelMotion {
+    fn velocity(&self, s: f64) -> Vec3 {
+        self.v_hinge + self.v_per_metre * s
+    }
+}
+
+fn pre_latch(chain: &Chain, plate: &Plate, ev: &LatchEvent) -> PreLatch {
+    let cfg = chain.configuration(&ev.q);
+    let qd = &ev.qd_before;
+    let free = matches!(chain.hub, PlanarHub::Free { .. });
+    let (theta, hub_state) = if free {
+        (ev.q[2], [ev.q[0], ev.q[1], ev.q[2]])
+    } else {
+        (0.0, [0.0; 3])
+    };
+    let (ea, nn) = (plate.length_axis, plate.normal);
+    let z = ea.cross(nn);
+    let (s, c) = theta.sin_cos();
+    // Plane (world) → structure frame: turn by −θ, then u → e_a, v → n.
+    let to3 = |p: P2| -> Vec3 { ea * (c * p[0] + s * p[1]) + nn * (-s * p[0] + c * p[1]) };
+    let (v_hub, w_hub) = if free {
+        (to3([qd[0], qd[1]]), z * qd[2])
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    };
+    let hv = chain.hinge_velocities(&cfg, qd);
+    let w = chain.phi_rates(qd);
+    let mut start = 0.0;
+    let panels = chain
+        .panels
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let e = [cfg.phi[i].cos(), cfg.phi[i].sin()];
+            let pm = PanelMotion {
+                start,
+                length: p.length,
+                mass: p.mass,
+                inertia: p.inertia,
+                v_hinge: to3(hv[i]),
+                v_per_metre: to3([-w[i] * e[1], w[i] * e[0]]),
+                omega: z * w[i],
+            };
+            start += p.length;
+            pm
+        })
+        .collect();
+    PreLatch {
+        v_hub,
+        w_hub,
+        panels,
+        theta,
+        hub_state,
+    }
+}
+
+/// The mass properties of everything but the deploying plate, about the hub's centre of mass.
+fn rigid_rest(st: &Structure, plate: &str) -> RigidBody {
+    let mut total = st.hub.rigid_body().about(-st.hub.center_of_mass);
+    for b in &st.beams {
+        total = total.plus(&b.rigid_body().about(-st.attachment_point(&b.attachment)));
+    }
+    for p in st.plates.iter().filter(|p| p.name != plate) {
+        total = total.plus(&p.rigid_body().about(-st.attachment_point(&p.attachment)));
+    }
+    for m in &st.masses {
+        total = total.plus(&m.rigid_body().about(-st.attachment_point(&m.attachment)));
+    }
+    total.about(st.hub.center_of_mass)
+}
+
+/// [p; L] = B [V; Ω] of a rigid body about the reference point.
+fn rigid_momentum(rb: &RigidBody, v: Vec3, w: Vec3) -> Momentum {
+    Momentum {
+        linear: v * rb.mass + w.cross(rb.first_moment),
+        angular: rb.first_moment.cross(v) + rb.inertia.apply(w),
+    }
+}
+
+/// The generalized impulse Φ(p)ᵀ S of an impulse S (N·s, structure frame) applied at a point
+/// of a beam (`local` = [station from the root, 0]) or a plate (`local` = [x from the root
+/// edge, y across the width from its centre line]): b = Tᵀ[S; r × S] + own functions·S.
+/// Other components (hub, lumped masses) take it at their attachment point (r = 0).
+pub fn point_impulse(model: &RitzModel, id: ComponentId, local: [f64; 2], s: Vec3) -> Vec<f64> {
+    let n = model.dof();
+    let mut b = vec![0.0; n];
+    let Some(e) = model.element(id) else {
+        return b;
+    };
+    let st = &model.structure;
+    let (r, own): (Vec3, Vec<(usize, f64)>) = match (&id, &e.basis) {
+        (
+            ComponentId::Beam(i),
+            ElementBasis::Beam {
+                axial,
+                bending,
+                torsion: _,
+            },
+        ) => {
+            let beam = &st.beams[*i];
+            let f = beam.frame;
+            let xi = (local[0] / beam.length).clamp(0.0, 1.0);
+            let mut own = Vec::new();
+            let xa = axial.eval_vec(xi);
+            let xb = bending.eval_vec(xi);
+            for (field, comp, vals) in [(0, f.ex, &xa), (1, f.ey, &xb), (2, f.ez, &xb)] {
+                let fr = &e.fields[field];
+                for k in 0..fr.len {
+                    own.push((fr.start + k, vals[k][0] * comp.dot(s)));
+                }
+            }
+            (f.ex * local[0], own)
+        }
+        (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
+            let p = &st.plates[*i];
+            let xv = length.eval_vec((local[0] / p.length).clamp(0.0, 1.0));
+            let yv = width.eval_vec((local[1] / p.width + 0.5).clamp(0.0, 1.0));
+            let start = e.own_range().start;
+            let sn = p.normal.dot(s);
+            let mut own = Vec::new();
+            for (m, x) in xv.iter().enumerate() {
+                for (k, y) in yv.iter().enumerate() {
+                    own.push((start + m * yv.len() + k, x[0] * y[0] * sn));
+                }
+            }
+            (p.length_axis * local[0] + p.width_axis() * local[1], own)
+        }
+        _ => (Vec3::ZERO, Vec::new()),
+    };
+    let m = r.cross(s);
+    let t = &e.attachment;
+    for (c, bc) in b.iter_mut().enumerate() {
+        for i in 0..3 {
+            *bc += t[(i, c)] * s.get(i) + t[(3 + i, c)] * m.get(i);
+        }
+    }
+    for (k, v) in own {
+        b[k] += v;
+    }
+    b
+}
+
+/// Modal velocities η̇_j = φ_jᵀ b of a generalized impulse b, for every mode of the
+/// analysis (mass-normalised shapes; a fixed hub's entries are zero).
+pub fn modal_velocities(modal: &ModalAnalysis, b: &[f64]) -> Vec<f64> {
+    modal
+        .modes
+        .iter()
+        .map(|m| m.shape.iter().zip(b).map(|(p, v)| p * v).sum())
+        .collect()
+}
+
+/// Hands the motion over at the final latch (see the module documentation).
+pub fn hand_over(
+    model: &RitzModel,
+    modal: &ModalAnalysis,
+    deployment: &Deployment,
+    result: &DeploymentResult,
+    method: HandoverMethod,
+) -> Result<Handover, ResponseError> {
+    let last = match result.latches.last() {
+        Some(ev) if result.all_latched => ev,
+        _ => {
+            return Err(ResponseError::NotLatched {
+                hinges: result.unlatched.iter().map(|u| u.0).collect(),
+                time: result.final_time,
+            })
+        }
+    };
+    let view = PlateView::find(model, &deployment.plate)?;
+    let st = &model.structure;
+    let chain = &deployment.chain;
+    let pl = pre_latch(chain, view.plate, last);
+    let n = model.dof();
+    let c_hub = st.hub.center_of_mass;
+    let mut notes = Vec::new();
+
+    // Before: the chain's bodies and the rigid rest of the structure.
+    let rest = rigid_rest(st, &deployment.plate);
+    let mut before = rigid_momentum(&rest, pl.v_hub, pl.w_hub);
+    let mut energy_before = 0.5 * (pl.v_hub.dot(before.linear) + pl.w_hub.dot(before.angular));
+    let origin = view.element.origin;
+    let ea = view.plate.length_axis;
+    for p in &pl.panels {
+        let centre = origin + ea * (p.start + 0.5 * p.length) - c_hub;
+        let v = p.velocity(0.5 * p.length);
+        before.linear = before.linear + v * p.mass;
+        before.angular = before.angular + centre.cross(v) * p.mass + p.omega * p.inertia;
+        energy_before += 0.5 * (p.mass * v.dot(v) + p.inertia * p.omega.dot(p.omega));
+    }
+
+    let (ea, nn) = (view.plate.length_axis, view.plate.normal);
+    let (a, width, mu) = (
+        view.plate.length,
+        view.plate.width,
+        view.plate.areal_density,
+    );
+    let (nx, ny) = (view.xb.len(), view.yb.len());
+    let mut b = vec![0.0; n];
+    let mut energy_before_field = energy_before;
+    match method {
+        HandoverMethod::Projection => {
+            let mut xv = vec![[0.0; 4]; nx];
+            let mut yv = vec![[0.0; 4]; ny];
+            // q̇_h: the hub's rigid velocity in Ritz coordinates.
+            let mut qh = vec![0.0; n];
+            if st.hub.motion == HubMotion::Free {
+                for i in 0..3 {
+                    qh[i] = pl.v_hub.get(i);
+                    qh[3 + i] = pl.w_hub.get(i);
+                }
+            } else if pl.v_hub.norm() > 0.0 || pl.w_hub.norm() > 0.0 {
+                notes.push(
+                    "the hub is free during deployment but fixed in the structure: its motion at \
+                     the latch is dropped from the hand-over"
+                        .to_string(),
+                );
+            }
+            // ∫Y_n dη, with the width basis's own rule.
+            let yq = view.yb.quadrature();
+            let mut ybar = vec![0.0; ny];
+            for (&eta, &w) in yq.points.iter().zip(&yq.weights) {
+                view.yb.eval_all(eta, &mut yv);
+                for (k, y) in ybar.iter_mut().enumerate() {
+                    *y += w * yv[k][0];
+                }
+            }
+            let xq: Quadrature = view.xb.quadrature();
+            let (mut fu, mut fth) = (Vec3::ZERO, Vec3::ZERO);
+            let mut fg = vec![0.0; nx * ny];
+            let mut ke_delta = 0.0;
+            let rigid = |x: f64| pl.v_hub + pl.w_hub.cross(origin + ea * x - c_hub);
+            for p in &pl.panels {
+                for (&xi, &w) in xq.points.iter().zip(&xq.weights) {
+                    let s = xi * p.length;
+                    let x = p.start + s;
+                    let wt = w * p.length * mu * width;
+                    let dv = p.velocity(s) - rigid(x);
+                    fu = fu + dv * wt;
+                    fth = fth + (ea * x).cross(dv) * wt;
+                    ke_delta += 0.5 * wt * dv.dot(dv);
+                    view.xb.eval_all((x / a).clamp(0.0, 1.0), &mut xv);
+                    let dn = nn.dot(dv) * wt;
+                    for m in 0..nx {
+                        for k in 0..ny {
+                            fg[m * ny + k] += xv[m][0] * ybar[k] * dn;
+                        }
+                    }
+                }
+            }
+            view.scatter(&mut b, fu, fth, &fg);
+            let m = &model.mass;
+            let mut kinetic_h = 0.0;
+            let mut cross = 0.0;
+            for r in 0..n {
+                let mq: f64 = (0..HUB_DOF).map(|c| m[(r, c)] * qh[c]).sum();
+                kinetic_h += 0.5 * qh[r] * mq;
+                cross += qh[r] * b[r];
+                b[r] += mq;
+            }
+            energy_before_field = kinetic_h + cross + ke_delta;
+        }
+        HandoverMethod::Impulse => {
+            let (s, c) = pl.theta.sin_cos();
+            let pi = model
+                .structure
+                .plates
+                .iter()
+                .position(|p| p.name == deployment.plate)
+                .ok_or_else(|| ResponseError::UnknownPlate(deployment.plate.clone()))?;
+            for (i, p) in pl.panels.iter().enumerate() {
+                let sp = last.impulses[i].0;
+                let imp = ea * (c * sp[0] + s * sp[1]) + nn * (-s * sp[0] + c * sp[1]);
+                let bi = point_impulse(
+                    model,
+                    ComponentId::Plate(pi),
+                    [p.start + 0.5 * p.length, 0.0],
+                    imp,
+                );
+                b.iter_mut().zip(&bi).for_each(|(x, y)| *x += y);
+            }
+        }
+    }
+    let eta_dot = modal_velocities(modal, &b);
+    let mut qdot = vec![0.0; n];
+    for (m, &v) in modal.modes.iter().zip(&eta_dot) {
+        for (q, p) in qdot.iter_mut().zip(&m.shape) {
+            *q += p * v;
+        }
+    }
+    let energy_after = 0.5 * eta_dot.iter().map(|v| v * v).sum::<f64>();
+    let m = &model.mass;
+    let row = |r: usize| (0..n).map(|c| m[(r, c)] * qdot[c]).sum::<f64>();
+    let momentum_after = Momentum {
+        linear: Vec3::new(row(0), row(1), row(2)),
+        angular: Vec3::new(row(3), row(4), row(5)),
+    };
+    let angle_mismatch = chain
+        .hinges
+        .iter()
+        .enumerate()
+        .map(|(i, h)| (last.q[chain.hub_dof() + i] - h.latch_angle).abs())
+        .fold(0.0, f64::max);
+    if (energy_before_field - energy_before).abs() > 1e-9 * energy_before.abs().max(1e-300) {
+        notes.push(format!(
+            "the panels' masses or inertias differ from the plate's density field: kinetic \
+             energy before the latch {energy_before:.6e} J from the panels, \
+             {energy_before_field:.6e} J from the plate (the hand-over projects the plate's)"
+        ));
+    }
+    Ok(Handover {
+        method,
+        latch_time: last.time,
+        latch_hinge: last.hinge,
+        generalized_impulse: b,
+        modal_velocity: eta_dot,
+        qdot,
+        energy_before,
+        energy_before_field,
+        energy_after,
+        momentum_before: before,
+        momentum_after,
+        angle_mismatch,
+        hub_state: pl.hub_state,
+        notes,
+    })
+}

@@ -1,0 +1,317 @@
+//! Latch-excited response (issue 4, MODEL.md §3.3): a series solution, conservation of
+//! momentum through the hand-over and the response, energy conservation and the energy
+//! balance of damped modes.
+
+use super::common::{bisect, scenario};
+use flexcraft::math::Vec3;
+use flexcraft::response::channels::standard_channels;
+use flexcraft::response::handover::{modal_velocities, point_impulse};
+use flexcraft::response::{HandoverMethod, ModalResponse, ResponseSettings};
+use flexcraft::simulation::Simulation;
+use flexcraft::structure::ComponentId;
+use flexcraft::{ModalAnalysis, RitzModel};
+
+const SEED: &str = include_str!("../../examples/seed.toml");
+
+const E: f64 = 70e9;
+const RHO: f64 = 2700.0;
+const AREA: f64 = 1e-3;
+const IY: f64 = 1e-8;
+const L: f64 = 2.0;
+
+/// A cantilever along x on a fixed hub; w (along z) bends about y with EI_y. The other
+/// fields are made stiff so that the first five elastic modes are the w modes.
+fn cantilever() -> String {
+    format!(
+        r#"
+name = "cantilever"
+[hub]
+motion = "fixed"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[materials.al]
+youngs_modulus = {E}
+poisson_ratio = 0.3
+density = {RHO}
+[[beams]]
+name = "beam"
+parent = "hub"
+root = [0.0, 0.0, 0.0]
+axis = [1.0, 0.0, 0.0]
+length = {L}
+material = "al"
+section = {{ area = {AREA}, iy = {IY}, iz = 1e-4, torsion_constant = 2e-6, polar_inertia = 2e-6 }}
+terms = {{ bending = 20, torsion = 4, axial = 4 }}
+"#
+    )
+}
+
+/// A cantilever hit at its tip by an impulse P along z, from rest: the classical series
+/// (e.g. Meirovitch, *Fundamentals of Vibrations*, §8) with modes normalised to
+/// ∫₀ᴸ X_n² dx = L, for which X_n(L)² = 4:
+///   w(L, t) = Σ_n 4P / (ρ A L ω_n) · sin ω_n t,   ω_n = β_n² √(EI/(ρA L⁴)),
+///   cos β_n cosh β_n = −1.
+/// The Ritz response keeps the same five modes (`modes = 5`).
+#[test]
+fn cantilever_tip_impulse_matches_the_series_solution() {
+    let s = scenario(&cantilever());
+    let model = RitzModel::assemble(&s.structure);
+    let modal = ModalAnalysis::compute(&model).expect("modes");
+    let p = 0.01; // N·s
+    let b = point_impulse(
+        &model,
+        ComponentId::Beam(0),
+        [L, 0.0],
+        Vec3::new(0.0, 0.0, p),
+    );
+    let eta_dot = modal_velocities(&modal, &b);
+    let settings = ResponseSettings {
+        duration: 0.2,
+        output_rate: 2000.0,
+        modes: Some(5),
+        ..ResponseSettings::default()
+    };
+    let resp = ModalResponse::new(&modal, &eta_dot, &settings);
+    let channels = standard_channels(&model);
+    let hist = resp.sample(&modal, &channels, &settings);
+    let c = channels
+        .iter()
+        .position(|c| c.name == "beam_tip_w")
+        .expect("tip channel");
+
+    let scale = (E * IY / (RHO * AREA * L.powi(4))).sqrt();
+    let omegas: Vec<f64> = (1..=5)
+        .map(|n| {
+            let guess = (2.0 * n as f64 - 1.0) * std::f64::consts::PI / 2.0;
+            let beta = bisect(|b| b.cos() * b.cosh() + 1.0, guess - 0.5, guess + 0.5);
+            beta * beta * scale
+        })
+        .collect();
+    let series = |t: f64| -> f64 {
+        omegas
+            .iter()
+            .map(|w| 4.0 * p / (RHO * AREA * L * w) * (w * t).sin())
+            .sum()
+    };
+    let peak = (0..hist.times.len())
+        .map(|k| series(hist.times[k]).abs())
+        .fold(0.0, f64::max);
+    assert!(peak > 1e-6);
+    for (k, &t) in hist.times.iter().enumerate() {
+        let err = (hist.values[(k, c)] - series(t)).abs();
+        assert!(
+            err < 1e-8 * peak,
+            "t = {t}: Ritz {} series {} (err/peak {:.2e})",
+            hist.values[(k, c)],
+            series(t),
+            err / peak
+        );
+    }
+}
+
+/// Damped modes: the energy lost up to T equals the work of the modal damping forces,
+/// E(0) − E(T) = Σ_j ∫₀ᵀ 2ζω_j η̇_j² dt (Simpson's rule on a fine grid).
+#[test]
+fn damped_response_obeys_the_energy_balance() {
+    let s = scenario(&cantilever());
+    let model = RitzModel::assemble(&s.structure);
+    let modal = ModalAnalysis::compute(&model).expect("modes");
+    let b = point_impulse(
+        &model,
+        ComponentId::Beam(0),
+        [0.7 * L, 0.0],
+        Vec3::new(0.0, 0.003, 0.01),
+    );
+    let eta_dot = modal_velocities(&modal, &b);
+    let zeta = 0.02;
+    let settings = ResponseSettings {
+        duration: 0.05,
+        output_rate: 4.0e5,
+        modes: Some(6),
+        damping_ratio: zeta,
+        ..ResponseSettings::default()
+    };
+    let resp = ModalResponse::new(&modal, &eta_dot, &settings);
+    let hist = resp.sample(&modal, &standard_channels(&model), &settings);
+    let n = hist.times.len();
+    assert_eq!(n % 2, 1, "Simpson needs an even number of intervals");
+    let h = 1.0 / settings.output_rate;
+    let power = |k: usize| -> f64 {
+        (0..resp.modes.len())
+            .filter(|&j| !resp.modes[j].rigid)
+            .map(|j| {
+                let (_, ed) = resp.state(j, hist.times[k]);
+                2.0 * zeta * resp.modes[j].omega * ed * ed
+            })
+            .sum()
+    };
+    let mut work = power(0) + power(n - 1);
+    for k in 1..n - 1 {
+        work += if k % 2 == 1 { 4.0 } else { 2.0 } * power(k);
+    }
+    work *= h / 3.0;
+    let lost = hist.elastic_energy[0] - hist.elastic_energy[n - 1];
+    assert!(lost > 0.1 * hist.elastic_energy[0], "damping must act");
+    assert!(
+        (lost - work).abs() < 1e-7 * hist.elastic_energy[0],
+        "lost {lost} vs damping work {work}"
+    );
+}
+
+/// A free hub with the wing on its side: the hand-over and the response keep the linear
+/// and angular momentum of the deploying chain (computed by the chain's own formula), and
+/// the kinetic energy before the latch is the chain's.
+#[test]
+fn free_hub_hand_over_conserves_momentum_and_the_response_carries_it() {
+    for method in ["projection", "impulse"] {
+        let toml = format!(
+            r#"
+name = "free hub with a side wing"
+[hub]
+motion = "free"
+mass = 500.0
+inertia = [300.0, 400.0, 350.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[[plates]]
+name = "wing"
+parent = "hub"
+root = [1.2, 0.0, 0.4]
+length_axis = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+length = 6.0
+width = 1.5
+areal_density = 5.0
+bending_stiffness = 2.0e4
+poisson_ratio = 0.3
+terms = {{ length = 8, width = 4 }}
+[deployment]
+plate = "wing"
+panels = 3
+hub = "free"
+[deployment.hinge]
+stiffness = 3.0
+preload_angle = 0.3
+[[deployment.hinges]]
+stiffness = 9.0
+initial_rate = 0.05            # so that the system's momentum is not zero
+[[deployment.hinges]]
+[[deployment.hinges]]
+[response]
+duration = 20.0
+output_rate = 20.0
+handover = "{method}"
+"#
+        );
+        let s = scenario(&toml);
+        let sim = Simulation::run(&s).expect("simulate");
+        let r = sim.response.as_ref().expect("all latched");
+        let h = &r.handover;
+        let d = s.deployment.as_ref().unwrap();
+        let ev = sim.deployment.latches.last().unwrap();
+        let chain = &d.chain;
+
+        // The chain's own momentum (about the plane origin) and energy, turned into the
+        // hub's body axes: u → x, v → z, ẑ_plane = x × z = −y.
+        let (p, l_o) = chain.momentum(&ev.q, &ev.qd_before);
+        let (hu, hv, th) = (ev.q[0], ev.q[1], ev.q[2]);
+        let l_p = l_o - (hu * p[1] - hv * p[0]);
+        let (sn, cs) = th.sin_cos();
+        let p_body = [cs * p[0] + sn * p[1], -sn * p[0] + cs * p[1]];
+        let before = h.momentum_before;
+        let scale_p = p[0].hypot(p[1]);
+        let scale_l = l_p.abs();
+        assert!(scale_p > 1e-3 && scale_l > 1e-3);
+        if method == "projection" {
+            assert!((before.linear.get(0) - p_body[0]).abs() < 1e-9 * scale_p);
+            assert!((before.linear.get(2) - p_body[1]).abs() < 1e-9 * scale_p);
+            assert!((before.angular.get(1) + l_p).abs() < 1e-9 * scale_l);
+            let ke = chain.kinetic_energy(&ev.q, &ev.qd_before);
+            assert!((h.energy_before - ke).abs() < 1e-9 * ke);
+            assert!((h.energy_before_field - ke).abs() < 1e-9 * ke);
+            assert!(h.energy_after <= h.energy_before * (1.0 + 1e-12));
+            for i in 0..3 {
+                assert!(
+                    (h.momentum_after.linear.get(i) - before.linear.get(i)).abs() < 1e-9 * scale_p,
+                    "linear {i}: {:?} vs {:?}",
+                    h.momentum_after,
+                    before
+                );
+                assert!(
+                    (h.momentum_after.angular.get(i) - before.angular.get(i)).abs()
+                        < 1e-9 * scale_l,
+                    "angular {i}: {:?} vs {:?}",
+                    h.momentum_after,
+                    before
+                );
+            }
+        } else {
+            // The paper's route: the structure at rest receives Σ S_i.
+            let mut total = [0.0; 2];
+            for (s_i, _) in &ev.impulses {
+                total[0] += s_i[0];
+                total[1] += s_i[1];
+            }
+            let t_body = [
+                cs * total[0] + sn * total[1],
+                -sn * total[0] + cs * total[1],
+            ];
+            let lin = h.momentum_after.linear;
+            let sc = t_body[0].hypot(t_body[1]);
+            assert!((lin.get(0) - t_body[0]).abs() < 1e-9 * sc);
+            assert!(lin.get(1).abs() < 1e-9 * sc);
+            assert!((lin.get(2) - t_body[1]).abs() < 1e-9 * sc);
+        }
+
+        // Through the response: M[0..3, :] q̇(t) stays the hand-over momentum.
+        let m = &sim.model.mass;
+        let n = sim.model.dof();
+        for &t in &[0.0, 3.7, 11.1, 20.0] {
+            let mut qd = vec![0.0; n];
+            for (j, km) in r.modal.modes.iter().enumerate() {
+                let (_, ed) = r.modal.state(j, t);
+                let shape = &sim.modes.modes[km.number - 1].shape;
+                for (q, s) in qd.iter_mut().zip(shape) {
+                    *q += s * ed;
+                }
+            }
+            for i in 0..3 {
+                let pi: f64 = (0..n).map(|c| m[(i, c)] * qd[c]).sum();
+                let want = h.momentum_after.linear.get(i);
+                let sc = h.momentum_after.linear.norm();
+                assert!((pi - want).abs() < 1e-9 * sc, "t = {t}: {pi} vs {want}");
+            }
+        }
+        assert_eq!(
+            h.method,
+            if method == "impulse" {
+                HandoverMethod::Impulse
+            } else {
+                HandoverMethod::Projection
+            }
+        );
+    }
+}
+
+/// The bundled example: undamped modal superposition keeps the elastic energy to rounding
+/// over the whole run, the projection loses energy (never gains), and the kept modes'
+/// energy fraction is reported.
+#[test]
+fn seed_response_conserves_energy_and_reports_truncation() {
+    let s = scenario(SEED);
+    let sim = Simulation::run(&s).expect("simulate");
+    let r = sim.response.as_ref().expect("latched");
+    let h = &r.handover;
+    assert!(
+        r.history.energy_drift() < 1e-12,
+        "{}",
+        r.history.energy_drift()
+    );
+    assert!(h.energy_after <= h.energy_before * (1.0 + 1e-12));
+    assert!((h.energy_before_field - h.energy_before).abs() < 1e-9 * h.energy_before);
+    let f = r.modal.captured_energy_fraction;
+    assert!(f > 0.0 && f <= 1.0);
+    // The kept modes' share equals Σ_kept ½η̇² / Σ_all ½η̇².
+    let kept: f64 = r.modal.modes.iter().map(|m| 0.5 * m.eta_dot0.powi(2)).sum();
+    assert!((kept / h.energy_after - f).abs() < 1e-12);
+}
