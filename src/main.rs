@@ -44,6 +44,20 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
+    /// The whole story: modes of the deployed spacecraft, deployment of the array, hand-over
+    /// at the final latch and the latch-excited vibration, hub drift and attitude motion.
+    #[command(after_help = UNITS)]
+    Simulate {
+        /// Scenario file (TOML, format version 1, with [deployment] and optionally [response]).
+        scenario: PathBuf,
+        /// Print summary.json on stdout instead of the summary table.
+        #[arg(long)]
+        json: bool,
+        /// Also write summary.json, modes.json, deployment.csv, events.json, response.csv and
+        /// plots here.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -59,6 +73,11 @@ fn main() -> ExitCode {
             json,
             out,
         } => run_deploy(&scenario, json, out.as_deref()),
+        Command::Simulate {
+            scenario,
+            json,
+            out,
+        } => run_simulate(&scenario, json, out.as_deref()),
     }
 }
 
@@ -144,6 +163,62 @@ fn run_deploy(path: &std::path::Path, json: bool, out: Option<&std::path::Path>)
                 return ExitCode::from(1);
             }
         }
+    }
+    ExitCode::SUCCESS
+}
+
+/// `flexcraft simulate`: exit 2 on a refused scenario (or one without [deployment]), 1 on a
+/// numerical failure or an unwritable output; an array that does not latch is reported
+/// (no response) with exit status 0, as in `deploy`.
+fn run_simulate(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
+    use flexcraft::simulation::{Simulation, SimulationError};
+    let started = std::time::Instant::now();
+    let scenario = match Scenario::from_file(path) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let sim = match Simulation::run(&scenario) {
+        Ok(s) => s,
+        Err(SimulationError::NoDeployment) => {
+            eprintln!(
+                "error: {}: deployment: the scenario has no [deployment] section (see docs/scenario.md)",
+                path.display()
+            );
+            return ExitCode::from(2);
+        }
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return ExitCode::from(1);
+        }
+    };
+    if json {
+        emit(&(output::simulate_json(&scenario, &sim) + "\n"));
+    } else {
+        emit(&output::simulate_table(&scenario, &sim));
+    }
+    if let Some(dir) = out {
+        let written = OutputDir::create(dir).and_then(|mut o| {
+            output::write_simulate(&mut o, &scenario, &sim)?;
+            o.commit()
+        });
+        match written {
+            Ok(files) => {
+                if !json {
+                    emit(&format!("wrote {} files to {}\n", files, dir.display()));
+                }
+            }
+            Err(e) => {
+                eprintln!("error: writing {}: {e}", dir.display());
+                return ExitCode::from(1);
+            }
+        }
+    }
+    if !json {
+        // Wall time on the terminal only: no file carries it (outputs stay byte-identical).
+        eprintln!("done in {:.3} s", started.elapsed().as_secs_f64());
     }
     ExitCode::SUCCESS
 }

@@ -48,7 +48,8 @@ pub struct Simulation {
     pub deployment: DeploymentResult,
     /// The response, when every hinge latched.
     pub response: Option<Response>,
-    /// Plain-language warnings (swing-back, clamped mode count, hand-over notes, …).
+    /// Plain-language warnings of the hand-over and response (clamped mode count, hand-over
+    /// notes, …); the deployment's own are [`crate::output::deploy_warnings`].
     pub warnings: Vec<String>,
 }
 
@@ -63,7 +64,7 @@ impl Simulation {
         let model = RitzModel::assemble(&scenario.structure);
         let modes = ModalAnalysis::compute(&model)?;
         let deployment = deploy::simulate(d);
-        let mut warnings = crate::output::deploy_warnings(d, &deployment);
+        let mut warnings = Vec::new();
         let response = match hand_over(&model, &modes, d, &deployment, settings.handover) {
             Ok(handover) => {
                 warnings.extend(handover.notes.iter().cloned());

@@ -5,10 +5,12 @@ mod atomic;
 mod deploy;
 mod modes;
 pub mod plot;
+mod simulate;
 
 pub use atomic::OutputDir;
 pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
+pub use simulate::{simulate_json, simulate_table, write_simulate};
 
 use thiserror::Error;
 

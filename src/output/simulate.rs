@@ -1,0 +1,414 @@
+//! `flexcraft simulate` outputs: the terminal summary, summary.json, response.csv and the
+//! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
+
+use super::plot::{line_chart, Series};
+use super::{deploy_table, modes_json, write_deploy, OutputDir, OutputError};
+use crate::math::Vec3;
+use crate::response::ChannelKind;
+use crate::scenario::Scenario;
+use crate::simulation::{Response, Simulation};
+use serde_json::{json, Value};
+use std::fmt::Write;
+
+fn v3(v: Vec3) -> [f64; 3] {
+    v.0
+}
+
+/// Rigid-body velocity of the hub after the hand-over (translation m/s, rotation rad/s):
+/// the part of the hub's motion that grows linearly in time.
+fn hub_rigid_rates(sim: &Simulation, r: &Response) -> ([f64; 3], [f64; 3]) {
+    let (mut v, mut w) = ([0.0; 3], [0.0; 3]);
+    for m in r.modal.modes.iter().filter(|m| m.rigid) {
+        let shape = &sim.modes.modes[m.number - 1].shape;
+        for i in 0..3 {
+            v[i] += shape[i] * m.eta_dot0;
+            w[i] += shape[3 + i] * m.eta_dot0;
+        }
+    }
+    (v, w)
+}
+
+fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
+    let h = &r.handover;
+    let st = &s.response;
+    let channels: Vec<Value> = r
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(c, ch)| {
+            let (peak, at) = r.history.peak(c);
+            json!({"name": ch.name, "label": ch.label, "unit": ch.unit, "peak": peak, "peak_time": at, "final": r.history.last(c)})
+        })
+        .collect();
+    let (rv, rw) = hub_rigid_rates(sim, r);
+    let last = |kind: ChannelKind| -> Vec<f64> {
+        r.channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.kind == kind)
+            .map(|(i, _)| r.history.last(i))
+            .collect()
+    };
+    json!({
+        "handover": {
+            "method": h.method.name(),
+            "latch_time": h.latch_time,
+            "latch_hinge": h.latch_hinge,
+            "energy_before": h.energy_before,
+            "energy_before_plate_field": h.energy_before_field,
+            "energy_after": h.energy_after,
+            "energy_lost": h.energy_before - h.energy_after,
+            "captured_energy_fraction": r.modal.captured_energy_fraction,
+            "momentum_before": {"linear": v3(h.momentum_before.linear), "angular": v3(h.momentum_before.angular)},
+            "momentum_after": {"linear": v3(h.momentum_after.linear), "angular": v3(h.momentum_after.angular)},
+            "angle_mismatch": h.angle_mismatch,
+            "hub_in_deployment_plane": h.hub_state,
+        },
+        "response": {
+            "duration": st.duration,
+            "output_rate": st.output_rate,
+            "rows": r.history.times.len(),
+            "damping_ratio": st.damping_ratio,
+            "elastic_modes_available": r.modal.available_elastic,
+            "elastic_modes_requested": r.modal.requested_elastic,
+            "elastic_modes_kept": r.modal.kept_elastic(),
+            "elastic_energy_drift": r.history.energy_drift(),
+            "kept_modes": r.modal.modes.iter().map(|m| json!({
+                "number": m.number, "rigid": m.rigid,
+                "frequency_hz": m.omega / (2.0 * std::f64::consts::PI),
+                "initial_modal_velocity": m.eta_dot0,
+            })).collect::<Vec<_>>(),
+            "channels": channels,
+            "hub": {
+                "translation_final": last(ChannelKind::HubTranslation),
+                "rotation_final": last(ChannelKind::HubRotation),
+                "rigid_velocity": rv,
+                "rigid_rate": rw,
+            },
+        },
+    })
+}
+
+/// summary.json (and `simulate --json`).
+pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
+    let d = s.deployment.as_ref();
+    let dep = &sim.deployment;
+    let mut v = json!({
+        "units": {
+            "time": "s", "length": "m", "angle": "rad", "energy": "J (kinetic unless stated)",
+            "linear_momentum": "N·s", "angular_momentum": "N·m·s, about the hub's centre of mass",
+            "frequency": "Hz", "modal_velocity": "√kg·m/s (mass-normalised modes)",
+            "axes": "structure frame (the hub's body axes at the final latch)",
+        },
+        "name": s.name,
+        "deployment": {
+            "plate": d.map(|d| d.plate.clone()),
+            "panels": d.map(|d| d.chain.len()),
+            "all_latched": dep.all_latched,
+            "final_time": dep.final_time,
+            "latches": dep.latches.iter().map(|e| json!({
+                "hinge": e.hinge, "time": e.time, "energy_before": e.energy_before,
+                "energy_after": e.energy_after,
+                "hinge_impulses": e.impulses.iter().enumerate().map(|(i, (f, m))| json!({
+                    "hinge": i + 1, "force": f, "moment": m})).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        },
+        "modes": {
+            "dof": sim.modes.dof,
+            "rigid": sim.modes.modes.iter().filter(|m| m.rigid).count(),
+            "elastic": sim.modes.modes.iter().filter(|m| !m.rigid).count(),
+            "first_frequencies_hz": sim.modes.elastic().take(10).map(|m| m.frequency_hz()).collect::<Vec<_>>(),
+        },
+        "handover": Value::Null,
+        "response": Value::Null,
+        "warnings": s.deployment.as_ref().map_or(Vec::new(), |d| super::deploy_warnings(d, dep)).into_iter().chain(sim.warnings.iter().cloned()).collect::<Vec<_>>(),
+    });
+    if let Some(r) = &sim.response {
+        let extra = response_json(sim, s, r);
+        v["handover"] = extra["handover"].clone();
+        v["response"] = extra["response"].clone();
+    }
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// The terminal summary.
+pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
+    let mut o = String::new();
+    let _ = writeln!(o, "flexcraft simulate: {}", s.name);
+    let _ = writeln!(
+        o,
+        "SI units: s, m, rad, J, N·s, N·m·s, Hz; structure axes = the hub's body axes\n"
+    );
+    let _ = writeln!(
+        o,
+        "Modes: {} coordinates, {} rigid + {} elastic",
+        sim.modes.dof,
+        sim.modes.modes.iter().filter(|m| m.rigid).count(),
+        sim.modes.elastic().count()
+    );
+    if let Some(d) = &s.deployment {
+        o.push('\n');
+        o.push_str(&deploy_table(&s.name, d, &sim.deployment));
+    }
+    let Some(r) = &sim.response else {
+        let _ = writeln!(o, "\nno response: the array did not latch completely");
+        return o;
+    };
+    let h = &r.handover;
+    let _ = writeln!(
+        o,
+        "\nResponse modes: {} rigid + {} of {} elastic kept",
+        r.modal.modes.iter().filter(|m| m.rigid).count(),
+        r.modal.kept_elastic(),
+        r.modal.available_elastic
+    );
+    let _ = writeln!(
+        o,
+        "{:>6} {:>12} {:>7} {:>16}",
+        "mode", "f [Hz]", "rigid", "η̇(0) [√kg·m/s]"
+    );
+    let shown = r.modal.modes.len().min(16);
+    for m in &r.modal.modes[..shown] {
+        let _ = writeln!(
+            o,
+            "{:>6} {:>12.6} {:>7} {:>16.6e}",
+            m.number,
+            m.omega / (2.0 * std::f64::consts::PI),
+            if m.rigid { "yes" } else { "" },
+            m.eta_dot0
+        );
+    }
+    if shown < r.modal.modes.len() {
+        let _ = writeln!(
+            o,
+            "   … {} more in summary.json",
+            r.modal.modes.len() - shown
+        );
+    }
+    let lost = h.energy_before - h.energy_after;
+    let _ = writeln!(
+        o,
+        "\nHand-over at t = {:.6} s (latch of hinge {}), method {}:",
+        h.latch_time,
+        h.latch_hinge,
+        h.method.name()
+    );
+    let _ = writeln!(
+        o,
+        "  kinetic energy before {:.6e} J, after {:.6e} J, difference {:.6e} J ({:.4} %)",
+        h.energy_before,
+        h.energy_after,
+        lost,
+        100.0 * lost / h.energy_before.max(1e-300)
+    );
+    let _ = writeln!(
+        o,
+        "  kept modes carry {:.6} % of the hand-over energy",
+        100.0 * r.modal.captured_energy_fraction
+    );
+    let f = |v: Vec3| format!("[{:.6e}, {:.6e}, {:.6e}]", v.0[0], v.0[1], v.0[2]);
+    let _ = writeln!(
+        o,
+        "  momentum before: linear {} N·s, angular {} N·m·s",
+        f(h.momentum_before.linear),
+        f(h.momentum_before.angular)
+    );
+    let _ = writeln!(
+        o,
+        "  momentum after:  linear {} N·s, angular {} N·m·s",
+        f(h.momentum_after.linear),
+        f(h.momentum_after.angular)
+    );
+    let st = &s.response;
+    let _ = writeln!(
+        o,
+        "\nResponse over {} s after the latch ({} samples at {} Hz, ζ = {}):",
+        st.duration,
+        r.history.times.len(),
+        st.output_rate,
+        st.damping_ratio
+    );
+    for (c, ch) in r.channels.iter().enumerate() {
+        if matches!(ch.kind, ChannelKind::BeamTip { .. } | ChannelKind::PlateTip { .. }) {
+            let (p, t) = r.history.peak(c);
+            let _ = writeln!(
+                o,
+                "  peak {:<34} {:>13.6e} {} at t = {:.3} s",
+                ch.label, p, ch.unit, t
+            );
+        }
+    }
+    let (rv, rw) = hub_rigid_rates(sim, r);
+    let finals = |kind: ChannelKind| -> String {
+        let v: Vec<String> = r
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.kind == kind)
+            .map(|(i, _)| format!("{:.6e}", r.history.last(i)))
+            .collect();
+        format!("[{}]", v.join(", "))
+    };
+    let _ = writeln!(
+        o,
+        "  hub drift: translation at the end {} m; rigid-body velocity [{:.6e}, {:.6e}, {:.6e}] m/s",
+        finals(ChannelKind::HubTranslation),
+        rv[0],
+        rv[1],
+        rv[2]
+    );
+    let _ = writeln!(
+        o,
+        "  attitude change: rotation at the end {} rad; rigid-body rate [{:.6e}, {:.6e}, {:.6e}] rad/s",
+        finals(ChannelKind::HubRotation),
+        rw[0],
+        rw[1],
+        rw[2]
+    );
+    let _ = writeln!(
+        o,
+        "  elastic energy drift over the run: {:.2e} (relative)",
+        r.history.energy_drift()
+    );
+    for w in &sim.warnings {
+        let _ = writeln!(o, "warning: {w}");
+    }
+    o
+}
+
+fn num(v: f64) -> String {
+    format!("{v:e}")
+}
+
+/// Writes summary.json, modes.json, the deployment's files, response.csv and plots.
+pub fn write_simulate(dir: &mut OutputDir, s: &Scenario, sim: &Simulation) -> Result<(), OutputError> {
+    dir.write("summary.json", simulate_json(s, sim) + "\n")?;
+    dir.write("modes.json", modes_json(&sim.model, &sim.modes) + "\n")?;
+    if let Some(d) = &s.deployment {
+        write_deploy(dir, &s.name, d, &sim.deployment)?;
+    }
+    let Some(r) = &sim.response else {
+        return Ok(());
+    };
+    let hist = &r.history;
+    let mut c = String::from("t [s]");
+    for ch in &r.channels {
+        let _ = write!(c, ",{} [{}]", ch.name, ch.unit);
+    }
+    for m in &r.modal.modes {
+        let _ = write!(c, ",eta_{} [√kg·m]", m.number);
+    }
+    c.push('\n');
+    for (k, &t) in hist.times.iter().enumerate() {
+        c.push_str(&num(t));
+        for j in 0..r.channels.len() {
+            c.push(',');
+            c.push_str(&num(hist.values[(k, j)]));
+        }
+        for j in 0..r.modal.modes.len() {
+            c.push(',');
+            c.push_str(&num(hist.modal[(k, j)]));
+        }
+        c.push('\n');
+    }
+    dir.write("response.csv", c)?;
+
+    let series = |pick: &dyn Fn(&crate::response::Channel) -> bool| -> Vec<Series> {
+        r.channels
+            .iter()
+            .enumerate()
+            .filter(|(_, ch)| pick(ch))
+            .map(|(j, ch)| {
+                (
+                    ch.label.clone(),
+                    hist.times
+                        .iter()
+                        .enumerate()
+                        .map(|(k, &t)| (t, hist.values[(k, j)]))
+                        .collect(),
+                )
+            })
+            .collect()
+    };
+    for b in &s.structure.beams {
+        let kind = ChannelKind::BeamTip {
+            beam: b.name.clone(),
+        };
+        line_chart(
+            dir,
+            &format!("response_{}_tip", b.name),
+            &format!("{} tip: elastic deflection in both bending planes (fig. 2.4)", b.name),
+            ("t after the latch [s]", "deflection [m]"),
+            &series(&|ch| ch.kind == kind && ch.unit == "m"),
+            false,
+        )?;
+        line_chart(
+            dir,
+            &format!("response_{}_twist", b.name),
+            &format!("{} tip: elastic twist (fig. 2.4)", b.name),
+            ("t after the latch [s]", "twist [rad]"),
+            &series(&|ch| ch.kind == kind && ch.unit == "rad"),
+            false,
+        )?;
+    }
+    for p in &s.structure.plates {
+        let kind = ChannelKind::PlateTip {
+            plate: p.name.clone(),
+        };
+        line_chart(
+            dir,
+            &format!("response_{}_tip", p.name),
+            &format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
+            ("t after the latch [s]", "deflection [m]"),
+            &series(&|ch| ch.kind == kind),
+            false,
+        )?;
+    }
+    line_chart(
+        dir,
+        "response_hub_translation",
+        "hub translation along the structure axes (fig. 2.6)",
+        ("t after the latch [s]", "translation [m]"),
+        &series(&|ch| ch.kind == ChannelKind::HubTranslation),
+        false,
+    )?;
+    line_chart(
+        dir,
+        "response_hub_rotation",
+        "hub rotation about the structure axes (fig. 2.7)",
+        ("t after the latch [s]", "rotation [rad]"),
+        &series(&|ch| ch.kind == ChannelKind::HubRotation),
+        false,
+    )?;
+    let modal: Vec<Series> = r
+        .modal
+        .modes
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| !m.rigid)
+        .take(8)
+        .map(|(j, m)| {
+            (
+                format!(
+                    "mode {} ({:.3} Hz)",
+                    m.number,
+                    m.omega / (2.0 * std::f64::consts::PI)
+                ),
+                hist.times
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &t)| (t, hist.modal[(k, j)]))
+                    .collect(),
+            )
+        })
+        .collect();
+    line_chart(
+        dir,
+        "response_modal_amplitudes",
+        "modal amplitudes of the first elastic modes",
+        ("t after the latch [s]", "η [√kg·m]"),
+        &modal,
+        false,
+    )?;
+    Ok(())
+}
