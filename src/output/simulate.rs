@@ -229,7 +229,10 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         st.damping_ratio
     );
     for (c, ch) in r.channels.iter().enumerate() {
-        if matches!(ch.kind, ChannelKind::BeamTip { .. } | ChannelKind::PlateTip { .. }) {
+        if matches!(
+            ch.kind,
+            ChannelKind::BeamTip { .. } | ChannelKind::PlateTip { .. }
+        ) {
             let (p, t) = r.history.peak(c);
             let _ = writeln!(
                 o,
@@ -281,7 +284,11 @@ fn num(v: f64) -> String {
 }
 
 /// Writes summary.json, modes.json, the deployment's files, response.csv and plots.
-pub fn write_simulate(dir: &mut OutputDir, s: &Scenario, sim: &Simulation) -> Result<(), OutputError> {
+pub fn write_simulate(
+    dir: &mut OutputDir,
+    s: &Scenario,
+    sim: &Simulation,
+) -> Result<(), OutputError> {
     dir.write("summary.json", simulate_json(s, sim) + "\n")?;
     dir.write("modes.json", modes_json(&sim.model, &sim.modes) + "\n")?;
     if let Some(d) = &s.deployment {
@@ -337,7 +344,10 @@ pub fn write_simulate(dir: &mut OutputDir, s: &Scenario, sim: &Simulation) -> Re
         line_chart(
             dir,
             &format!("response_{}_tip", b.name),
-            &format!("{} tip: elastic deflection in both bending planes (fig. 2.4)", b.name),
+            &format!(
+                "{} tip: elastic deflection in both bending planes (fig. 2.4)",
+                b.name
+            ),
             ("t after the latch [s]", "deflection [m]"),
             &series(&|ch| ch.kind == kind && ch.unit == "m"),
             false,

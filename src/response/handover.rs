@@ -155,8 +155,8 @@ struct PreLatch {
     /// Hub's centre-of-mass velocity and angular velocity.
     v_hub: Vec3,
     w_hub: Vec3,
-    /// Per panel: start x along the wing, length, hinge velocity, angular rate (3-D vectors
-    /// in the structure frame).
+    /// Per panel: place on the straight wing, mass properties and rigid motion (structure
+    /// frame).
     panels: Vec<PanelMotion>,
     theta: f64,
     hub_state: [f64; 3],
@@ -167,17 +167,22 @@ struct PanelMotion {
     length: f64,
     mass: f64,
     inertia: f64,
-    /// Velocity of the hinge point H_i.
-    v_hinge: Vec3,
-    /// φ̇_i ẑ × e(φ_i) in the structure frame: the velocity per metre along the panel.
+    /// Velocity of the panel's centre.
+    v_centre: Vec3,
+    /// φ̇_i ẑ × e_a: the velocity per metre along the (straight) panel.
     v_per_metre: Vec3,
     /// φ̇_i ẑ.
     omega: Vec3,
 }
 
 impl PanelMotion {
+    /// Velocity of the point at distance s from the panel's hinge on the straight wing: the
+    /// panel's rigid motion (centre velocity, rate) carried over to its straight position,
+    /// which keeps each panel's momentum, angular momentum about its centre and kinetic
+    /// energy when simultaneous latching locks the array bent (MODEL.md §3.3). For the
+    /// straight wing it is the chain's own velocity field.
     fn velocity(&self, s: f64) -> Vec3 {
-        self.v_hinge + self.v_per_metre * s
+        self.v_centre + self.v_per_metre * (s - 0.5 * self.length)
     }
 }
 
@@ -209,14 +214,16 @@ fn pre_latch(chain: &Chain, plate: &Plate, ev: &LatchEvent) -> PreLatch {
         .enumerate()
         .map(|(i, p)| {
             let e = [cfg.phi[i].cos(), cfg.phi[i].sin()];
+            let half = 0.5 * p.length * w[i];
+            let omega = z * w[i];
             let pm = PanelMotion {
                 start,
                 length: p.length,
                 mass: p.mass,
                 inertia: p.inertia,
-                v_hinge: to3(hv[i]),
-                v_per_metre: to3([-w[i] * e[1], w[i] * e[0]]),
-                omega: z * w[i],
+                v_centre: to3([hv[i][0] - half * e[1], hv[i][1] + half * e[0]]),
+                v_per_metre: omega.cross(ea),
+                omega,
             };
             start += p.length;
             pm

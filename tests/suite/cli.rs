@@ -185,6 +185,54 @@ fn bad_cases() -> Vec<(
             "between 1 and 100",
         ),
         (
+            "response duration",
+            SEED,
+            "duration = 60.0",
+            "duration = 0.0",
+            "response.duration",
+            "positive",
+        ),
+        (
+            "response rows",
+            SEED,
+            "output_rate = 50.0",
+            "output_rate = 5e5",
+            "response.output_rate",
+            "30000001 rows; the limit is 10000000",
+        ),
+        (
+            "response damping",
+            SEED,
+            "damping_ratio = 0.0",
+            "damping_ratio = 1.5",
+            "response.damping_ratio",
+            "below 1",
+        ),
+        (
+            "response modes",
+            SEED,
+            "modes = 20",
+            "modes = 0",
+            "response.modes",
+            "at least 1",
+        ),
+        (
+            "response handover",
+            SEED,
+            "handover = \"projection\"",
+            "handover = \"magic\"",
+            "handover",
+            "unknown variant",
+        ),
+        (
+            "response key",
+            SEED,
+            "damping_ratio = 0.0",
+            "damping = 0.0",
+            "damping",
+            "unknown field",
+        ),
+        (
             "basis",
             SEED,
             "basis = \"legendre\"",
@@ -203,7 +251,9 @@ fn bad_input_is_refused_with_location_key_reason_and_exit_2_and_no_output() {
         let file = dir.join("scenario.toml");
         std::fs::write(&file, src.replacen(from, to, 1)).unwrap();
         let out = dir.join("out");
-        let sub = if name.contains("panel")
+        let sub = if name.starts_with("response") {
+            "simulate"
+        } else if name.contains("panel")
             || name.contains("stiffness")
             || name.contains("damping")
             || name.contains("latch")
@@ -331,7 +381,12 @@ fn outputs_are_complete_and_byte_identical_across_runs() {
 
 #[test]
 fn help_states_si_units() {
-    for args in [vec!["--help"], vec!["modes", "--help"]] {
+    for args in [
+        vec!["--help"],
+        vec!["modes", "--help"],
+        vec!["deploy", "--help"],
+        vec!["simulate", "--help"],
+    ] {
         let r = bin().args(&args).output().unwrap();
         let s = String::from_utf8_lossy(&r.stdout);
         assert!(s.contains("SI"), "{args:?}: {s}");
@@ -423,5 +478,160 @@ fn an_array_that_cannot_latch_is_reported_not_hung() {
     assert_eq!(v["all_latched"], serde_json::Value::Bool(false));
     assert!(!v["unlatched"].as_array().unwrap().is_empty());
     assert!((v["final_time"].as_f64().unwrap() - 60.0).abs() < 1e-9);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_writes_complete_reproducible_outputs() {
+    let dir = scratch("simulate");
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/seed.toml");
+    let mut printed = Vec::new();
+    for run in ["a", "b"] {
+        let r = bin()
+            .arg("simulate")
+            .arg(&scenario)
+            .arg("--out")
+            .arg(dir.join(run))
+            .output()
+            .unwrap();
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        printed.push(String::from_utf8_lossy(&r.stdout).into_owned());
+    }
+    let text = &printed[0];
+    for needle in [
+        "Hand-over at t =",
+        "kinetic energy before",
+        "peak mast tip deflection w",
+        "peak wing tip corner",
+        "hub drift",
+        "attitude change",
+        "latch of hinge",
+    ] {
+        assert!(text.contains(needle), "summary lacks {needle}: {text}");
+    }
+    let a = entries(&dir.join("a"));
+    for f in [
+        "summary.json",
+        "modes.json",
+        "deployment.csv",
+        "response.csv",
+        "events.json",
+        "plots",
+    ] {
+        assert!(a.contains(&f.to_string()), "{f} missing: {a:?}");
+    }
+    let plots = entries(&dir.join("a/plots"));
+    for p in [
+        "response_mast_tip",
+        "response_mast_twist",
+        "response_wing_tip",
+        "response_hub_translation",
+        "response_hub_rotation",
+        "response_modal_amplitudes",
+    ] {
+        for ext in ["png", "svg"] {
+            let f = format!("{p}.{ext}");
+            assert!(plots.contains(&f), "{f} missing");
+            assert!(
+                std::fs::metadata(dir.join("a/plots").join(&f))
+                    .unwrap()
+                    .len()
+                    > 1000
+            );
+        }
+    }
+    for f in a.iter().filter(|f| *f != "plots").chain(plots.iter()) {
+        let rel = if f.contains('.') && plots.contains(f) {
+            format!("plots/{f}")
+        } else {
+            f.clone()
+        };
+        let x = std::fs::read(dir.join("a").join(&rel)).unwrap();
+        let y = std::fs::read(dir.join("b").join(&rel)).unwrap();
+        assert!(x == y, "{rel} differs between runs");
+    }
+    // summary.json: the interface numbers, consistent with response.csv.
+    let v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("a/summary.json")).unwrap()).unwrap();
+    let h = &v["handover"];
+    let (eb, ea) = (
+        h["energy_before"].as_f64().unwrap(),
+        h["energy_after"].as_f64().unwrap(),
+    );
+    assert!(ea <= eb && ea > 0.0);
+    let frac = h["captured_energy_fraction"].as_f64().unwrap();
+    assert!(frac > 0.9 && frac < 1.0, "20 of 74 modes: {frac}");
+    let resp = &v["response"];
+    assert_eq!(resp["elastic_modes_kept"].as_u64(), Some(20));
+    assert_eq!(resp["rows"].as_u64(), Some(3001));
+    let csv = std::fs::read_to_string(dir.join("a/response.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert!(header[0] == "t [s]" && header.contains(&"wing_tip_plus [m]"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 3001);
+    assert_eq!(rows[3000][0], 60.0);
+    let col = header
+        .iter()
+        .position(|h| *h == "wing_tip_plus [m]")
+        .unwrap();
+    let peak = rows.iter().map(|r| r[col].abs()).fold(0.0, f64::max);
+    let ch = resp["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "wing_tip_plus")
+        .unwrap();
+    assert_eq!(peak, ch["peak"].as_f64().unwrap());
+    // --json prints the same object as summary.json.
+    let r = bin()
+        .arg("simulate")
+        .arg(&scenario)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(j, v);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn simulate_clamps_too_many_modes_and_refuses_a_scenario_without_deployment() {
+    let dir = scratch("simulate-bad");
+    let file = dir.join("s.toml");
+    std::fs::write(&file, SEED.replace("modes = 20", "modes = 5000")).unwrap();
+    let r = bin()
+        .arg("simulate")
+        .arg(&file)
+        .arg("--json")
+        .output()
+        .unwrap();
+    assert!(r.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(
+        v["response"]["elastic_modes_kept"],
+        v["response"]["elastic_modes_available"]
+    );
+    assert!(v["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("response.modes = 5000")));
+    let cut = SEED.find("[deployment]").unwrap();
+    let resp = SEED.find("[response]").unwrap();
+    std::fs::write(&file, format!("{}{}", &SEED[..cut], &SEED[resp..])).unwrap();
+    let out = dir.join("out");
+    let r = bin()
+        .arg("simulate")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("[deployment]"));
+    assert!(!out.exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
