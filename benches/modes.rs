@@ -76,5 +76,43 @@ fn bench_deploy(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, bench_deploy);
+/// The whole simulation of the seed example (library: modes, deployment, hand-over,
+/// response), and the response alone for 100 elastic modes × 10⁵ samples.
+fn bench_response(c: &mut Criterion) {
+    use flexcraft::response::channels::standard_channels;
+    use flexcraft::response::{ModalResponse, ResponseSettings};
+    use flexcraft::simulation::Simulation;
+    let mut g = c.benchmark_group("response");
+    g.sample_size(10);
+    let s = Scenario::from_toml_str(SEED, "seed.toml").expect("seed");
+    g.bench_function("seed simulate (default settings)", |b| {
+        b.iter(|| black_box(Simulation::run(black_box(&s)).expect("simulate")))
+    });
+    // 100 of 122 elastic modes (plate 12 × 8), 10⁵ samples (2000 s at 50 Hz).
+    let big = seed_with((8, 6, 4), (12, 8));
+    let sim = Simulation::run(&big).expect("simulate");
+    let eta_dot = sim
+        .response
+        .as_ref()
+        .expect("latched")
+        .handover
+        .modal_velocity
+        .clone();
+    let settings = ResponseSettings {
+        duration: 1999.99,
+        output_rate: 50.0,
+        modes: Some(100),
+        ..ResponseSettings::default()
+    };
+    assert_eq!(settings.rows(), 100_000);
+    let channels = standard_channels(&sim.model);
+    let resp = ModalResponse::new(&sim.modes, &eta_dot, &settings);
+    assert_eq!(resp.kept_elastic(), 100);
+    g.bench_function("100 modes x 1e5 samples", |b| {
+        b.iter(|| black_box(resp.sample(&sim.modes, &channels, &settings)))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_deploy, bench_response);
 criterion_main!(benches);
