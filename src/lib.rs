@@ -6,7 +6,9 @@
 //! synthesis ([`ritz`]) over one of two bases ([`basis`]).
 //!
 //! Data flows one way: scenario file → [`structure::Structure`] → [`ritz::RitzModel`] →
-//! [`ritz::ModalAnalysis`] → outputs. The library never prints and never exits; the
+//! [`ritz::ModalAnalysis`] → outputs; [`deploy`] simulates the array's deployment and
+//! [`response`] the latch-excited vibration, chained end to end by
+//! [`simulation::Simulation::run`]. The library never prints and never exits; the
 //! `flexcraft` binary is a thin command-line layer over it.
 //!
 //! SI units throughout: m, kg, s, N, Pa, rad.
