@@ -2,9 +2,10 @@
 //! codes; the physics lives in the library.
 
 use clap::{Parser, Subcommand};
+use flexcraft::deploy::Deployment;
 use flexcraft::output::{self, OutputDir};
 use flexcraft::{ModalAnalysis, RitzModel, Scenario};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 const UNITS: &str = "Units: SI throughout — lengths m, masses kg, inertias kg·m², moduli Pa, \
@@ -62,7 +63,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    let done = match cli.command {
         Command::Modes {
             scenario,
             json,
@@ -78,149 +79,116 @@ fn main() -> ExitCode {
             json,
             out,
         } => run_simulate(&scenario, json, out.as_deref()),
-    }
+    };
+    done.err().unwrap_or(ExitCode::SUCCESS)
 }
 
-/// Exit status 2: the input was refused. 1: an output could not be written or a numerical
-/// failure.
-fn run_modes(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
-    let scenario = match Scenario::from_file(path) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let model = RitzModel::assemble(&scenario.structure);
-    let modes = match ModalAnalysis::compute(&model) {
-        Ok(m) => m,
-        Err(e) => {
-            eprintln!("error: {}: {e}", path.display());
-            return ExitCode::from(1);
-        }
-    };
-    if json {
-        emit(&(output::modes_json(&model, &modes) + "\n"));
-    } else {
-        emit(&output::modes_table(&scenario, &model, &modes));
-    }
-    if let Some(dir) = out {
-        let written = OutputDir::create(dir).and_then(|mut d| {
-            output::write_modes(&mut d, &model, &modes)?;
-            d.commit()
-        });
-        match written {
-            Ok(files) => {
-                if !json {
-                    println!("wrote {} files to {}", files, dir.display());
-                }
-            }
-            Err(e) => {
-                eprintln!("error: writing {}: {e}", dir.display());
-                return ExitCode::from(1);
-            }
-        }
-    }
-    ExitCode::SUCCESS
+/// Exit statuses: 2 the input was refused (the scenario, or a missing section the command
+/// needs); 1 a numerical failure or an output that could not be written; 0 otherwise — an
+/// array that does not latch is a result, not an error.
+const REFUSED: u8 = 2;
+const FAILED: u8 = 1;
+
+/// Reads and validates the scenario, reporting a refusal with its location.
+fn load(path: &Path) -> Result<Scenario, ExitCode> {
+    Scenario::from_file(path).map_err(|e| {
+        eprintln!("error: {e}");
+        ExitCode::from(REFUSED)
+    })
 }
 
-/// `flexcraft deploy`: exit 2 on a refused scenario (or one without [deployment]), 1 when an
-/// output cannot be written; an array that does not latch is a result, not an error (0).
-fn run_deploy(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
-    let scenario = match Scenario::from_file(path) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let Some(d) = &scenario.deployment else {
+/// The `[deployment]` section a command needs.
+fn need_deployment<'a>(path: &Path, s: &'a Scenario) -> Result<&'a Deployment, ExitCode> {
+    s.deployment.as_ref().ok_or_else(|| {
         eprintln!(
             "error: {}: deployment: the scenario has no [deployment] section (see docs/scenario.md)",
             path.display()
         );
-        return ExitCode::from(2);
-    };
-    let result = flexcraft::deploy::simulate(d);
-    if json {
-        emit(&(output::deploy_json(&scenario.name, d, &result) + "\n"));
-    } else {
-        emit(&output::deploy_table(&scenario.name, d, &result));
-    }
-    if let Some(dir) = out {
-        let written = OutputDir::create(dir).and_then(|mut o| {
-            output::write_deploy(&mut o, &scenario.name, d, &result)?;
-            o.commit()
-        });
-        match written {
-            Ok(files) => {
-                if !json {
-                    emit(&format!("wrote {} files to {}\n", files, dir.display()));
-                }
-            }
-            Err(e) => {
-                eprintln!("error: writing {}: {e}", dir.display());
-                return ExitCode::from(1);
-            }
-        }
-    }
-    ExitCode::SUCCESS
+        ExitCode::from(REFUSED)
+    })
 }
 
-/// `flexcraft simulate`: exit 2 on a refused scenario (or one without [deployment]), 1 on a
-/// numerical failure or an unwritable output; an array that does not latch is reported
-/// (no response) with exit status 0, as in `deploy`.
-fn run_simulate(path: &std::path::Path, json: bool, out: Option<&std::path::Path>) -> ExitCode {
-    use flexcraft::simulation::{Simulation, SimulationError};
-    let started = std::time::Instant::now();
-    let scenario = match Scenario::from_file(path) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let sim = match Simulation::run(&scenario) {
-        Ok(s) => s,
-        Err(SimulationError::NoDeployment) => {
-            eprintln!(
-                "error: {}: deployment: the scenario has no [deployment] section (see docs/scenario.md)",
-                path.display()
-            );
-            return ExitCode::from(2);
-        }
-        Err(e) => {
-            eprintln!("error: {}: {e}", path.display());
-            return ExitCode::from(1);
-        }
-    };
+/// Prints the JSON object or the table, then writes the output directory (staged, renamed
+/// when complete) with `write`.
+fn finish(
+    json: bool,
+    json_text: impl FnOnce() -> String,
+    table: impl FnOnce() -> String,
+    out: Option<&Path>,
+    write: impl FnOnce(&mut OutputDir) -> Result<(), output::OutputError>,
+) -> Result<(), ExitCode> {
     if json {
-        emit(&(output::simulate_json(&scenario, &sim) + "\n"));
+        emit(&(json_text() + "\n"));
     } else {
-        emit(&output::simulate_table(&scenario, &sim));
+        emit(&table());
     }
     if let Some(dir) = out {
         let written = OutputDir::create(dir).and_then(|mut o| {
-            output::write_simulate(&mut o, &scenario, &sim)?;
+            write(&mut o)?;
             o.commit()
         });
         match written {
-            Ok(files) => {
-                if !json {
-                    emit(&format!("wrote {} files to {}\n", files, dir.display()));
-                }
-            }
+            Ok(files) if !json => emit(&format!("wrote {} files to {}\n", files, dir.display())),
+            Ok(_) => {}
             Err(e) => {
                 eprintln!("error: writing {}: {e}", dir.display());
-                return ExitCode::from(1);
+                return Err(ExitCode::from(FAILED));
             }
         }
     }
+    Ok(())
+}
+
+fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+    let scenario = load(path)?;
+    let model = RitzModel::assemble(&scenario.structure);
+    let modes = ModalAnalysis::compute(&model).map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        ExitCode::from(FAILED)
+    })?;
+    finish(
+        json,
+        || output::modes_json(&model, &modes),
+        || output::modes_table(&scenario, &model, &modes),
+        out,
+        |d| output::write_modes(d, &model, &modes),
+    )
+}
+
+fn run_deploy(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+    let scenario = load(path)?;
+    let d = need_deployment(path, &scenario)?;
+    let result = flexcraft::deploy::simulate(d);
+    finish(
+        json,
+        || output::deploy_json(&scenario.name, d, &result),
+        || output::deploy_table(&scenario.name, d, &result),
+        out,
+        |o| output::write_deploy(o, &scenario.name, d, &result),
+    )
+}
+
+fn run_simulate(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+    use flexcraft::simulation::Simulation;
+    let started = std::time::Instant::now();
+    let scenario = load(path)?;
+    need_deployment(path, &scenario)?;
+    let sim = Simulation::run(&scenario).map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        ExitCode::from(FAILED)
+    })?;
+    finish(
+        json,
+        || output::simulate_json(&scenario, &sim),
+        || output::simulate_table(&scenario, &sim),
+        out,
+        |o| output::write_simulate(o, &scenario, &sim),
+    )?;
     if !json {
         // Wall time on the terminal only: no file carries it (outputs stay byte-identical).
         eprintln!("done in {:.3} s", started.elapsed().as_secs_f64());
     }
-    ExitCode::SUCCESS
+    Ok(())
 }
 
 /// Prints to stdout; a closed pipe (`flexcraft modes … | head`) is not an error.
