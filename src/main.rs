@@ -54,10 +54,16 @@ enum Command {
         /// Print summary.json on stdout instead of the summary table.
         #[arg(long)]
         json: bool,
-        /// Also write summary.json, modes.json, deployment.csv, events.json, response.csv and
-        /// plots here.
+        /// Also write report.html (one self-contained page), summary.json, modes.json,
+        /// deployment.csv, events.json, response.csv and plots here.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Open DIR/report.html in the default browser when done (needs --out).
+        #[arg(long, requires = "out")]
+        open: bool,
+        /// No progress bar (it is shown only on a terminal, for runs longer than a second).
+        #[arg(long, short)]
+        quiet: bool,
     },
 }
 
@@ -78,7 +84,9 @@ fn main() -> ExitCode {
             scenario,
             json,
             out,
-        } => run_simulate(&scenario, json, out.as_deref()),
+            open,
+            quiet,
+        } => run_simulate(&scenario, json, out.as_deref(), open, quiet),
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
 }
@@ -168,27 +176,106 @@ fn run_deploy(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCod
     )
 }
 
-fn run_simulate(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+fn run_simulate(
+    path: &Path,
+    json: bool,
+    out: Option<&Path>,
+    open: bool,
+    quiet: bool,
+) -> Result<(), ExitCode> {
     use flexcraft::simulation::Simulation;
     let started = std::time::Instant::now();
+    let progress = Progress::new(quiet, started);
     let scenario = load(path)?;
     need_deployment(path, &scenario)?;
+    let source = std::fs::read(path).unwrap_or_default();
+    progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| {
         eprintln!("error: {}: {e}", path.display());
         ExitCode::from(FAILED)
     })?;
+    progress.stage(2, "writing outputs");
+    let file_name = path
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     finish(
         json,
         || output::simulate_json(&scenario, &sim),
         || output::simulate_table(&scenario, &sim),
         out,
-        |o| output::write_simulate(o, &scenario, &sim),
+        |o| output::write_simulate(o, &scenario, &sim, &source, &file_name),
     )?;
+    progress.done();
     if !json {
         // Wall time on the terminal only: no file carries it (outputs stay byte-identical).
         eprintln!("done in {:.3} s", started.elapsed().as_secs_f64());
     }
+    if let (true, Some(dir)) = (open, out) {
+        open_in_browser(&dir.join("report.html"));
+    }
     Ok(())
+}
+
+/// A progress bar on stderr, drawn only on a terminal, only once the run has taken more than
+/// a second, and never with --quiet.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    started: std::time::Instant,
+}
+
+impl Progress {
+    const STAGES: u64 = 3;
+
+    fn new(quiet: bool, started: std::time::Instant) -> Self {
+        use std::io::IsTerminal;
+        let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let b = indicatif::ProgressBar::with_draw_target(
+                Some(Self::STAGES),
+                indicatif::ProgressDrawTarget::hidden(),
+            );
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:30}] {pos}/{len} {msg}",
+            ) {
+                b.set_style(style.progress_chars("=> "));
+            }
+            b
+        });
+        Self { bar, started }
+    }
+
+    fn stage(&self, k: u64, msg: &'static str) {
+        if let Some(b) = &self.bar {
+            if self.started.elapsed().as_secs_f64() > 1.0 && b.is_hidden() {
+                b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            }
+            b.set_position(k);
+            b.set_message(msg);
+        }
+    }
+
+    fn done(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// Opens a file with the desktop's default handler; a missing opener is a warning only.
+fn open_in_browser(file: &Path) {
+    let opener = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(target_os = "windows") {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    match std::process::Command::new(opener).arg(file).spawn() {
+        Ok(_) => {}
+        Err(e) => eprintln!(
+            "warning: could not open {} with {opener}: {e}; open it in a browser",
+            file.display()
+        ),
+    }
 }
 
 /// Prints to stdout; a closed pipe (`flexcraft modes … | head`) is not an error.

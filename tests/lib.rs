@@ -14,5 +14,6 @@ mod suite {
     pub mod modal_properties;
     pub mod mutations;
     pub mod plates;
+    pub mod report;
     pub mod response;
 }

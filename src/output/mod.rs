@@ -5,11 +5,13 @@ mod atomic;
 mod deploy;
 mod modes;
 pub mod plot;
+mod report;
 mod simulate;
 
 pub use atomic::OutputDir;
 pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
+pub use report::report_html;
 pub use simulate::{simulate_json, simulate_table, write_simulate};
 
 use thiserror::Error;

@@ -189,6 +189,20 @@ pub fn mode_shape(dir: &mut OutputDir, model: &RitzModel, mode: &Mode) -> Result
     Ok(())
 }
 
+/// The same picture as [`mode_shape`], as an SVG document in a string (for the HTML report).
+pub fn mode_shape_svg(model: &RitzModel, mode: &Mode) -> Result<String, OutputError> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1200, 640)).into_drawing_area();
+        draw_mode(root, model, mode).map_err(|reason| OutputError::Plot {
+            file: format!("report: mode {}", mode.number),
+            reason,
+        })?;
+    }
+    Ok(svg)
+}
+
 /// A named polyline for [`line_chart`].
 pub type Series = (String, Vec<(f64, f64)>);
 

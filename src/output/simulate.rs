@@ -268,11 +268,22 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         rw[1],
         rw[2]
     );
-    let _ = writeln!(
-        o,
-        "  elastic energy drift over the run: {:.2e} (relative)",
-        r.history.energy_drift()
-    );
+    if st.damping_ratio == 0.0 {
+        let _ = writeln!(
+            o,
+            "  elastic energy drift over the run: {:.2e} (relative; undamped, so rounding only)",
+            r.history.energy_drift()
+        );
+    } else {
+        let e = &r.history.elastic_energy;
+        let _ = writeln!(
+            o,
+            "  elastic energy at the end: {:.4} % of the hand-over's (modal damping ζ = {})",
+            100.0 * e.last().copied().unwrap_or(0.0)
+                / e.first().copied().unwrap_or(1.0).max(1e-300),
+            st.damping_ratio
+        );
+    }
     for w in &sim.warnings {
         let _ = writeln!(o, "warning: {w}");
     }
@@ -283,13 +294,21 @@ fn num(v: f64) -> String {
     format!("{v:e}")
 }
 
-/// Writes summary.json, modes.json, the deployment's files, response.csv and plots.
+/// Writes summary.json, report.html, modes.json, the deployment's files, response.csv and
+/// plots. `source` and `file_name` are the scenario file's bytes and name (the report's
+/// footer carries its SHA-256).
 pub fn write_simulate(
     dir: &mut OutputDir,
     s: &Scenario,
     sim: &Simulation,
+    source: &[u8],
+    file_name: &str,
 ) -> Result<(), OutputError> {
     dir.write("summary.json", simulate_json(s, sim) + "\n")?;
+    dir.write(
+        "report.html",
+        super::report_html(s, sim, source, file_name)?,
+    )?;
     dir.write("modes.json", modes_json(&sim.model, &sim.modes) + "\n")?;
     if let Some(d) = &s.deployment {
         write_deploy(dir, &s.name, d, &sim.deployment)?;

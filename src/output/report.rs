@@ -1,0 +1,751 @@
+//! `report.html`: one self-contained page (inline style, script, data and pictures; no
+//! network) with the scenario, the modes, the deployment and the response. Plots are drawn
+//! in the browser by a small inline script (`assets/report.js`: hover to read a value, drag
+//! to zoom a time window, double-click to reset) from data embedded as JSON; the mode shapes
+//! are the same SVG pictures as `plots/mode_NNN.svg`. Nothing time-dependent is written, so
+//! the page is byte-identical across runs.
+//!
+//! Every table number that is also in summary.json carries `data-key` (a JSON pointer into
+//! summary.json) and `data-value` (the full-precision value), which the tests compare.
+
+use super::plot::mode_shape_svg;
+use super::OutputError;
+use crate::deploy::chain::PlanarHub;
+use crate::math::Vec3;
+use crate::response::ChannelKind;
+use crate::scenario::Scenario;
+use crate::simulation::Simulation;
+use crate::structure::{HubMotion, Structure};
+use serde_json::{json, Value};
+use sha2::{Digest, Sha256};
+use std::fmt::Write;
+
+const SCRIPT: &str = include_str!("../../assets/report.js");
+const STYLE: &str = include_str!("../../assets/report.css");
+
+/// HTML-escapes user text (component names, file names).
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace('\'', "&#39;")
+}
+
+/// A table cell with a value that summary.json also holds.
+fn keyed(key: &str, v: f64, shown: String) -> String {
+    format!("<td data-key=\"{key}\" data-value=\"{v:e}\">{shown}</td>")
+}
+
+/// Seven significant digits keep the embedded plot data compact.
+fn round7(v: f64) -> f64 {
+    if v.is_finite() {
+        format!("{v:.6e}").parse().unwrap_or(v)
+    } else {
+        0.0
+    }
+}
+
+/// JSON for a `<script type="application/json">` block ("</" cannot close the element).
+fn embed(v: &Value) -> String {
+    serde_json::to_string(v)
+        .unwrap_or_default()
+        .replace("</", "<\\/")
+}
+
+/// An interactive chart: series of (x, y) samples.
+fn plot(
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    series: Vec<(String, Vec<f64>, Vec<f64>)>,
+) -> String {
+    let s: Vec<Value> = series
+        .into_iter()
+        .map(|(name, x, y)| {
+            json!({"name": name, "x": x.into_iter().map(round7).collect::<Vec<_>>(),
+                   "y": y.into_iter().map(round7).collect::<Vec<_>>()})
+        })
+        .collect();
+    let spec = json!({"title": title, "xlabel": xlabel, "ylabel": ylabel, "series": s});
+    format!(
+        "<figure class=\"plot\" data-title=\"{}\"><script type=\"application/json\">{}</script></figure>\n",
+        esc(title),
+        embed(&spec)
+    )
+}
+
+/// Two orthogonal views (x–z and x–y) of the deployed structure, labelled.
+fn sketch(st: &Structure) -> String {
+    // Segments and labelled points in the structure frame.
+    let mut segs: Vec<(Vec3, Vec3, &'static str)> = Vec::new();
+    let mut labels: Vec<(Vec3, String)> = Vec::new();
+    let hub = st.hub.center_of_mass;
+    labels.push((hub, "hub".into()));
+    for (i, b) in st.beams.iter().enumerate() {
+        let r = st.beam_root(i);
+        let t = r + b.frame.ex * b.length;
+        segs.push((r, t, "beam"));
+        labels.push((r + b.frame.ex * (0.5 * b.length), b.name.clone()));
+    }
+    for p in &st.plates {
+        let o = st.attachment_point(&p.attachment);
+        let (ea, eb) = (p.length_axis, p.width_axis());
+        let c = [
+            o + eb * (-0.5 * p.width),
+            o + eb * (0.5 * p.width),
+            o + eb * (0.5 * p.width) + ea * p.length,
+            o + eb * (-0.5 * p.width) + ea * p.length,
+        ];
+        for k in 0..4 {
+            segs.push((c[k], c[(k + 1) % 4], "plate"));
+        }
+        labels.push((o + ea * (0.5 * p.length), p.name.clone()));
+    }
+    for m in &st.masses {
+        labels.push((
+            st.attachment_point(&m.attachment) + m.offset,
+            m.name.clone(),
+        ));
+    }
+    let mut out = String::from("<div class=\"sketch\">");
+    for (axes, title) in [((0, 2), "side view (x–z)"), ((0, 1), "top view (x–y)")] {
+        let pts: Vec<(f64, f64)> = segs
+            .iter()
+            .flat_map(|(a, b, _)| [*a, *b])
+            .chain(labels.iter().map(|l| l.0))
+            .map(|p| (p.get(axes.0), p.get(axes.1)))
+            .collect();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in &pts {
+            x0 = x0.min(*x);
+            x1 = x1.max(*x);
+            y0 = y0.min(*y);
+            y1 = y1.max(*y);
+        }
+        let span = (x1 - x0).max(y1 - y0).max(1e-6);
+        let (w, h, m) = (560.0, 380.0, 40.0);
+        let s = ((w - 2.0 * m) / span).min((h - 2.0 * m) / span);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        let px = |x: f64| w / 2.0 + (x - cx) * s;
+        let py = |y: f64| h / 2.0 - (y - cy) * s;
+        let _ = write!(
+            out,
+            "<svg viewBox=\"0 0 {w} {h}\" width=\"49%\" role=\"img\"><rect width=\"{w}\" height=\"{h}\" fill=\"#fbfbfd\" stroke=\"#ccd\"/><text x=\"10\" y=\"18\" font-size=\"13\" font-weight=\"bold\">{title}, m</text>"
+        );
+        let _ = write!(
+            out,
+            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"9\" fill=\"#555\"/>",
+            px(hub.get(axes.0)),
+            py(hub.get(axes.1))
+        );
+        for (a, b, kind) in &segs {
+            let (color, width) = if *kind == "beam" {
+                ("#1e9646", 4)
+            } else {
+                ("#1f5ac8", 2)
+            };
+            let _ = write!(
+                out,
+                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{color}\" stroke-width=\"{width}\"/>",
+                px(a.get(axes.0)),
+                py(a.get(axes.1)),
+                px(b.get(axes.0)),
+                py(b.get(axes.1))
+            );
+        }
+        for (p, name) in &labels {
+            let _ = write!(
+                out,
+                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\" fill=\"#222\">{}</text>",
+                px(p.get(axes.0)) + 6.0,
+                py(p.get(axes.1)) - 6.0,
+                esc(name)
+            );
+        }
+        let _ = write!(
+            out,
+            "<text x=\"10\" y=\"{}\" font-size=\"11\" fill=\"#555\">{}: {:.3} … {:.3}; {}: {:.3} … {:.3}</text></svg>",
+            h - 8.0,
+            ["x", "y", "z"][axes.0],
+            x0,
+            x1,
+            ["x", "y", "z"][axes.1],
+            y0,
+            y1
+        );
+    }
+    out.push_str("</div>\n");
+    out
+}
+
+fn scenario_section(s: &Scenario) -> String {
+    let st = &s.structure;
+    let mut o = String::from("<section id=\"scenario\"><h2>Scenario</h2>\n");
+    let h = &st.hub;
+    let j = h.inertia;
+    let _ = writeln!(
+        o,
+        "<table><tr><th class=\"l\">hub</th><th>motion</th><th>mass [kg]</th><th>centre of mass [m]</th><th>J_xx, J_yy, J_zz [kg·m²]</th><th>total mass [kg]</th></tr>\
+         <tr><td class=\"l\">hub</td><td>{}</td><td>{:.6}</td><td>[{:.4}, {:.4}, {:.4}]</td><td>{:.6e}, {:.6e}, {:.6e}</td><td>{:.6}</td></tr></table>",
+        if h.motion == HubMotion::Free { "free" } else { "fixed" },
+        h.mass,
+        h.center_of_mass.0[0],
+        h.center_of_mass.0[1],
+        h.center_of_mass.0[2],
+        j.get(0, 0),
+        j.get(1, 1),
+        j.get(2, 2),
+        st.total_mass()
+    );
+    if !st.beams.is_empty() {
+        o.push_str("<table><tr><th class=\"l\">beam</th><th class=\"l\">parent</th><th>length [m]</th><th>mass [kg]</th><th>EA [N]</th><th>EI_y [N·m²]</th><th>EI_z [N·m²]</th><th>GJ [N·m²]</th><th>terms (bending, torsion, axial)</th></tr>\n");
+        for b in &st.beams {
+            let e = b.youngs_modulus;
+            let _ = writeln!(
+                o,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td><td>{}, {}, {}</td></tr>",
+                esc(&b.name),
+                esc(b.attachment.parent_name()),
+                b.length,
+                b.mass(),
+                e * b.section.area,
+                e * b.section.iy,
+                e * b.section.iz,
+                b.shear_modulus * b.section.torsion_constant,
+                b.terms.bending,
+                b.terms.torsion,
+                b.terms.axial
+            );
+        }
+        o.push_str("</table>\n");
+    }
+    if !st.plates.is_empty() {
+        o.push_str("<table><tr><th class=\"l\">plate</th><th class=\"l\">parent</th><th>length a [m]</th><th>width b [m]</th><th>mass [kg]</th><th>ρh [kg/m²]</th><th>D [N·m]</th><th>ν</th><th>terms (length × width)</th></tr>\n");
+        for p in &st.plates {
+            let _ = writeln!(
+                o,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4e}</td><td>{:.3}</td><td>{} × {}</td></tr>",
+                esc(&p.name),
+                esc(p.attachment.parent_name()),
+                p.length,
+                p.width,
+                p.mass(),
+                p.areal_density,
+                p.bending_stiffness,
+                p.poisson_ratio,
+                p.terms.length,
+                p.terms.width
+            );
+        }
+        o.push_str("</table>\n");
+    }
+    if !st.masses.is_empty() {
+        o.push_str("<table><tr><th class=\"l\">lumped mass</th><th class=\"l\">parent</th><th>mass [kg]</th><th>offset [m]</th></tr>\n");
+        for m in &st.masses {
+            let _ = writeln!(
+                o,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.4}</td><td>[{:.3}, {:.3}, {:.3}]</td></tr>",
+                esc(&m.name),
+                esc(m.attachment.parent_name()),
+                m.mass,
+                m.offset.0[0],
+                m.offset.0[1],
+                m.offset.0[2]
+            );
+        }
+        o.push_str("</table>\n");
+    }
+    o.push_str(&sketch(st));
+    o.push_str("</section>\n");
+    o
+}
+
+fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
+    let st = &sim.model.structure;
+    let mut o = String::from("<section id=\"modes\"><h2>Modes</h2>\n");
+    let _ = writeln!(
+        o,
+        "<p class=\"note\">{} generalized coordinates, basis {}, hub {}. SE: strain-energy share of each component. Effective masses of the hub-fixed elastic modes (kg; base-excitation measure) are listed for a fixed hub.</p>",
+        sim.modes.dof,
+        st.basis.name(),
+        if st.hub.motion == HubMotion::Free { "free" } else { "fixed" }
+    );
+    let comps: Vec<String> = sim
+        .modes
+        .elastic()
+        .next()
+        .map(|m| {
+            m.strain_energy_share
+                .iter()
+                .map(|(n, _)| n.clone())
+                .collect()
+        })
+        .unwrap_or_default();
+    o.push_str("<table id=\"frequencies\"><tr><th>mode</th><th class=\"l\">kind</th><th>f [Hz]</th><th>ω [rad/s]</th><th class=\"l\">dominant</th>");
+    for c in &comps {
+        let _ = write!(o, "<th>SE {}</th>", esc(c));
+    }
+    o.push_str("<th>m_eff x [kg]</th><th>m_eff y [kg]</th><th>m_eff z [kg]</th></tr>\n");
+    let mut elastic_index = 0;
+    for m in sim.modes.modes.iter().take(30) {
+        let f = m.frequency_hz();
+        let cell = if !m.rigid && elastic_index < 10 {
+            let c = keyed(
+                &format!("/modes/first_frequencies_hz/{elastic_index}"),
+                f,
+                format!("{f:.6}"),
+            );
+            elastic_index += 1;
+            c
+        } else {
+            format!("<td>{f:.6}</td>")
+        };
+        let _ = write!(
+            o,
+            "<tr><td>{}</td><td class=\"l\">{}</td>{cell}<td>{:.6}</td><td class=\"l\">{}</td>",
+            m.number,
+            if m.rigid { "rigid" } else { "elastic" },
+            m.omega_rad_s,
+            esc(m.dominant())
+        );
+        for c in &comps {
+            match m.share(c) {
+                Some(v) => {
+                    let _ = write!(o, "<td>{v:.4}</td>");
+                }
+                None => o.push_str("<td>–</td>"),
+            }
+        }
+        match m.effective_mass {
+            Some(e) => {
+                let _ = write!(
+                    o,
+                    "<td>{:.4e}</td><td>{:.4e}</td><td>{:.4e}</td>",
+                    e[0], e[1], e[2]
+                );
+            }
+            None => o.push_str("<td>–</td><td>–</td><td>–</td>"),
+        }
+        o.push_str("</tr>\n");
+    }
+    o.push_str("</table>\n");
+    if sim.modes.modes.len() > 30 {
+        let _ = writeln!(
+            o,
+            "<p class=\"note\">… {} more modes in modes.json.</p>",
+            sim.modes.modes.len() - 30
+        );
+    }
+    // Mode shapes: the first six elastic modes.
+    o.push_str("<h3>Mode shapes</h3><p class=\"note\">The first six elastic modes (rigid-body modes are not drawn): grey undeformed, blue deformed (exaggerated).</p><div class=\"modes\">\n");
+    for m in sim.modes.elastic().take(6) {
+        let svg = mode_shape_svg(&sim.model, m)?;
+        let _ = writeln!(
+            o,
+            "<figure class=\"shape\" data-mode=\"{}\">{svg}</figure>",
+            m.number
+        );
+    }
+    o.push_str("</div>\n");
+    // Coefficient tables as the paper's tables 2.2–2.3.
+    o.push_str("<h3>Ritz coefficients of the first two elastic modes (as the paper's tables 2.2–2.3)</h3><p class=\"note\">Mass-normalised shapes. Beams: v_k, w_k bending in the two planes (the paper's d, f), θ_k torsion (c); plates: g_mn (m along the length, n across the width; the width functions include the two rigid ones).</p>\n");
+    for m in sim.modes.elastic().take(2) {
+        let _ = write!(
+            o,
+            "<table class=\"coefficients\"><tr><th class=\"l\" colspan=\"2\">mode {} (f = {:.6} Hz)</th></tr>",
+            m.number,
+            m.frequency_hz()
+        );
+        for e in &sim.model.elements {
+            let name = st.component_name(e.id);
+            // (label, coordinate index) of the first two functions of each field.
+            let mut cells: Vec<(String, usize)> = Vec::new();
+            for f in &e.fields {
+                if let crate::structure::ComponentId::Plate(i) = e.id {
+                    let t = st.plates[i].terms;
+                    for mi in 0..t.length.min(2) {
+                        for ni in 0..t.width.min(2) {
+                            cells.push((
+                                format!("g_{}{}", mi + 1, ni + 1),
+                                f.start + mi * t.width + ni,
+                            ));
+                        }
+                    }
+                } else {
+                    for k in 0..f.len.min(2) {
+                        cells.push((format!("{}_{}", f.field, k + 1), f.start + k));
+                    }
+                }
+            }
+            for (label, idx) in cells {
+                let _ = write!(
+                    o,
+                    "<tr><td class=\"l\">{} {label}</td><td>{:.6e}</td></tr>",
+                    esc(name),
+                    m.shape[idx]
+                );
+            }
+        }
+        o.push_str("</table>\n");
+    }
+    o.push_str("</section>\n");
+    Ok(o)
+}
+
+fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
+    let mut o = String::from("<section id=\"deployment\"><h2>Deployment</h2>\n");
+    let Some(d) = &s.deployment else {
+        o.push_str("<p>No [deployment] section.</p></section>\n");
+        return o;
+    };
+    let r = &sim.deployment;
+    let _ = writeln!(
+        o,
+        "<p>Plate {}, {} panels, hub {}; {} at t = {:.6} s.</p>",
+        esc(&d.plate),
+        d.chain.len(),
+        match d.chain.hub {
+            PlanarHub::Fixed => "fixed",
+            PlanarHub::Free { .. } => "free",
+        },
+        if r.all_latched {
+            "all hinges latched"
+        } else {
+            "NOT all hinges latched"
+        },
+        r.final_time
+    );
+    // Animation frames: the hinge points of every sample, in the deployment plane.
+    let frames: Vec<Value> = r
+        .samples
+        .iter()
+        .map(|smp| {
+            json!({"t": round7(smp.t),
+                   "p": smp.hinges.iter().map(|p| [round7(p[0]), round7(p[1])]).collect::<Vec<_>>(),
+                   "h": [round7(smp.hub[0]), round7(smp.hub[1])]})
+        })
+        .collect();
+    let (mut u0, mut u1, mut v0, mut v1) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for smp in &r.samples {
+        for p in smp
+            .hinges
+            .iter()
+            .chain(std::iter::once(&[smp.hub[0], smp.hub[1]]))
+        {
+            u0 = u0.min(p[0]);
+            u1 = u1.max(p[0]);
+            v0 = v0.min(p[1]);
+            v1 = v1.max(p[1]);
+        }
+    }
+    let pad = 0.05 * (u1 - u0).max(v1 - v0).max(1e-6);
+    let spec = json!({"frames": frames, "box": [u0 - pad, u1 + pad, v0 - pad, v1 + pad]});
+    let _ = writeln!(
+        o,
+        "<h3>Animation</h3><div class=\"animation\" id=\"animation\"><script type=\"application/json\">{}</script>\
+         <div class=\"controls\"><button type=\"button\">play</button> <input type=\"range\" min=\"0\" value=\"0\" aria-label=\"time\"> <span class=\"time\"></span></div>\
+         <div class=\"stage\"></div><p class=\"note\">Deployment plane: u along the wing's length axis (right), v along its normal (up); the dark dot is the hub's centre of mass, red dots the hinges and the tip.</p></div>",
+        embed(&spec)
+    );
+    o.push_str("<h3>Latch events</h3><table id=\"latches\"><tr><th>latch</th><th>hinge</th><th>t [s]</th><th>kinetic energy before [J]</th><th>after [J]</th><th>lost [J]</th></tr>\n");
+    for (i, e) in r.latches.iter().enumerate() {
+        let _ = writeln!(
+            o,
+            "<tr><td>{}</td><td>{}</td>{}{}{}<td>{:.6e}</td></tr>",
+            i + 1,
+            e.hinge,
+            keyed(
+                &format!("/deployment/latches/{i}/time"),
+                e.time,
+                format!("{:.6}", e.time)
+            ),
+            keyed(
+                &format!("/deployment/latches/{i}/energy_before"),
+                e.energy_before,
+                format!("{:.6e}", e.energy_before)
+            ),
+            keyed(
+                &format!("/deployment/latches/{i}/energy_after"),
+                e.energy_after,
+                format!("{:.6e}", e.energy_after)
+            ),
+            e.energy_before - e.energy_after
+        );
+    }
+    o.push_str("</table>\n");
+    for w in super::deploy_warnings(d, r) {
+        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w));
+    }
+    let n = d.chain.len();
+    let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
+    let t: Vec<f64> = r.samples.iter().map(|s| s.t).collect();
+    let per_hinge = |f: &dyn Fn(&crate::deploy::Sample, usize) -> f64| {
+        shown
+            .iter()
+            .map(|&i| {
+                (
+                    format!("hinge {}", i + 1),
+                    t.clone(),
+                    r.samples.iter().map(|s| f(s, i)).collect(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    o.push_str(&plot(
+        "opening angles",
+        "t [s]",
+        "α [rad]",
+        per_hinge(&|s, i| s.alpha[i]),
+    ));
+    o.push_str(&plot(
+        "opening rates",
+        "t [s]",
+        "α̇ [rad/s]",
+        per_hinge(&|s, i| s.rate[i]),
+    ));
+    o.push_str(&plot(
+        "hinge reaction force magnitude (inboard body on panel i)",
+        "t [s]",
+        "|F| [N]",
+        per_hinge(&|s, i| s.force[i][0].hypot(s.force[i][1])),
+    ));
+    let hub: Vec<(String, Vec<f64>, Vec<f64>)> = ["u [m]", "v [m]", "θ [rad]"]
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            (
+                format!("hub {l}"),
+                t.clone(),
+                r.samples.iter().map(|s| s.hub[k]).collect(),
+            )
+        })
+        .collect();
+    o.push_str(&plot(
+        "hub motion in the deployment plane",
+        "t [s]",
+        "u, v [m]; θ [rad]",
+        hub,
+    ));
+    o.push_str("</section>\n");
+    o
+}
+
+fn response_section(s: &Scenario, sim: &Simulation) -> String {
+    let mut o = String::from("<section id=\"response\"><h2>Response</h2>\n");
+    let Some(r) = &sim.response else {
+        o.push_str(
+            "<p class=\"warn\">No response: the array did not latch completely.</p></section>\n",
+        );
+        return o;
+    };
+    let h = &r.handover;
+    let _ = writeln!(
+        o,
+        "<h3>Hand-over at the final latch</h3><p>t = {:.6} s (latch of hinge {}), method <b>{}</b>; {} s of response at {} Hz, ζ = {}, {} rigid + {} of {} elastic modes kept.</p>",
+        h.latch_time,
+        h.latch_hinge,
+        h.method.name(),
+        s.response.duration,
+        s.response.output_rate,
+        s.response.damping_ratio,
+        r.modal.modes.iter().filter(|m| m.rigid).count(),
+        r.modal.kept_elastic(),
+        r.modal.available_elastic
+    );
+    o.push_str("<table id=\"handover\"><tr><th class=\"l\">quantity</th><th>value</th></tr>\n");
+    let rows = [
+        (
+            "kinetic energy before [J]",
+            "/handover/energy_before",
+            h.energy_before,
+        ),
+        (
+            "kinetic energy after [J]",
+            "/handover/energy_after",
+            h.energy_after,
+        ),
+        (
+            "difference [J]",
+            "/handover/energy_lost",
+            h.energy_before - h.energy_after,
+        ),
+        (
+            "share of the hand-over energy in the kept modes",
+            "/handover/captured_energy_fraction",
+            r.modal.captured_energy_fraction,
+        ),
+        (
+            "elastic energy drift over the run (relative)",
+            "/response/elastic_energy_drift",
+            r.history.energy_drift(),
+        ),
+    ];
+    for (label, key, v) in rows {
+        let _ = writeln!(
+            o,
+            "<tr><td class=\"l\">{label}</td>{}</tr>",
+            keyed(key, v, format!("{v:.6e}"))
+        );
+    }
+    for (label, key, v) in [
+        (
+            "linear momentum before [N·s]",
+            "/handover/momentum_before/linear",
+            h.momentum_before.linear,
+        ),
+        (
+            "linear momentum after [N·s]",
+            "/handover/momentum_after/linear",
+            h.momentum_after.linear,
+        ),
+        (
+            "angular momentum before [N·m·s]",
+            "/handover/momentum_before/angular",
+            h.momentum_before.angular,
+        ),
+        (
+            "angular momentum after [N·m·s]",
+            "/handover/momentum_after/angular",
+            h.momentum_after.angular,
+        ),
+    ] {
+        let _ = write!(o, "<tr><td class=\"l\">{label}</td><td><table>");
+        let _ = write!(o, "<tr>");
+        for k in 0..3 {
+            o.push_str(&keyed(
+                &format!("{key}/{k}"),
+                v.0[k],
+                format!("{:.6e}", v.0[k]),
+            ));
+        }
+        o.push_str("</tr></table></td></tr>\n");
+    }
+    o.push_str("</table>\n");
+    for w in &sim.warnings {
+        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(w));
+    }
+    let hist = &r.history;
+    let t = hist.times.clone();
+    let pick = |f: &dyn Fn(&crate::response::Channel) -> bool| {
+        r.channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| f(c))
+            .map(|(j, c)| {
+                (
+                    c.label.clone(),
+                    t.clone(),
+                    (0..t.len()).map(|k| hist.values[(k, j)]).collect(),
+                )
+            })
+            .collect::<Vec<_>>()
+    };
+    let tl = "t after the latch [s]";
+    for b in &s.structure.beams {
+        let kind = ChannelKind::BeamTip {
+            beam: b.name.clone(),
+        };
+        o.push_str(&plot(
+            &format!(
+                "{} tip: elastic deflection in both bending planes (fig. 2.4)",
+                b.name
+            ),
+            tl,
+            "deflection [m]",
+            pick(&|c| c.kind == kind && c.unit == "m"),
+        ));
+        o.push_str(&plot(
+            &format!("{} tip: elastic twist (fig. 2.4)", b.name),
+            tl,
+            "twist [rad]",
+            pick(&|c| c.kind == kind && c.unit == "rad"),
+        ));
+    }
+    for p in &s.structure.plates {
+        let kind = ChannelKind::PlateTip {
+            plate: p.name.clone(),
+        };
+        o.push_str(&plot(
+            &format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
+            tl,
+            "deflection [m]",
+            pick(&|c| c.kind == kind),
+        ));
+    }
+    o.push_str(&plot(
+        "hub translation along the structure axes (fig. 2.6)",
+        tl,
+        "translation [m]",
+        pick(&|c| c.kind == ChannelKind::HubTranslation),
+    ));
+    o.push_str(&plot(
+        "hub rotation about the structure axes (fig. 2.7)",
+        tl,
+        "rotation [rad]",
+        pick(&|c| c.kind == ChannelKind::HubRotation),
+    ));
+    let modal: Vec<(String, Vec<f64>, Vec<f64>)> = r
+        .modal
+        .modes
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| !m.rigid)
+        .take(8)
+        .map(|(j, m)| {
+            (
+                format!(
+                    "mode {} ({:.3} Hz)",
+                    m.number,
+                    m.omega / (2.0 * std::f64::consts::PI)
+                ),
+                t.clone(),
+                (0..t.len()).map(|k| hist.modal[(k, j)]).collect(),
+            )
+        })
+        .collect();
+    o.push_str(&plot(
+        "modal amplitudes of the first elastic modes",
+        tl,
+        "η [√kg·m]",
+        modal,
+    ));
+    o.push_str("</section>\n");
+    o
+}
+
+/// The whole page. `source` is the scenario file's bytes (its SHA-256 is in the footer).
+pub fn report_html(
+    s: &Scenario,
+    sim: &Simulation,
+    source: &[u8],
+    file_name: &str,
+) -> Result<String, OutputError> {
+    let hash = Sha256::digest(source)
+        .iter()
+        .fold(String::new(), |mut h, b| {
+            let _ = write!(h, "{b:02x}");
+            h
+        });
+    let mut o = String::new();
+    let _ = write!(
+        o,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\
+         <title>flexcraft report: {}</title><style>{STYLE}</style></head>\n<body data-status=\"loading\">\n\
+         <h1>flexcraft report: {}</h1><p class=\"note\">SI units: m, kg, s, rad, N, J, Hz. Plots: hover to read values, drag to zoom a time window, double-click to reset.</p>\
+         <nav><a href=\"#scenario\">scenario</a><a href=\"#modes\">modes</a><a href=\"#deployment\">deployment</a><a href=\"#response\">response</a></nav>\n",
+        esc(&s.name),
+        esc(&s.name)
+    );
+    o.push_str(&scenario_section(s));
+    o.push_str(&modes_section(sim)?);
+    o.push_str(&deployment_section(s, sim));
+    o.push_str(&response_section(s, sim));
+    let _ = write!(
+        o,
+        "<footer>flexcraft {} · scenario {} · SHA-256 <code id=\"scenario-hash\">{hash}</code></footer>\n<script>{SCRIPT}</script>\n</body></html>\n",
+        env!("CARGO_PKG_VERSION"),
+        esc(file_name)
+    );
+    Ok(o)
+}
