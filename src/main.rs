@@ -185,7 +185,7 @@ fn run_simulate(
 ) -> Result<(), ExitCode> {
     use flexcraft::simulation::Simulation;
     let started = std::time::Instant::now();
-    let progress = Progress::new(quiet, started);
+    let progress = Progress::new(quiet);
     let scenario = load(path)?;
     need_deployment(path, &scenario)?;
     let source = std::fs::read(path).unwrap_or_default();
@@ -220,13 +220,12 @@ fn run_simulate(
 /// a second, and never with --quiet.
 struct Progress {
     bar: Option<indicatif::ProgressBar>,
-    started: std::time::Instant,
 }
 
 impl Progress {
     const STAGES: u64 = 3;
 
-    fn new(quiet: bool, started: std::time::Instant) -> Self {
+    fn new(quiet: bool) -> Self {
         use std::io::IsTerminal;
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let b = indicatif::ProgressBar::with_draw_target(
@@ -238,16 +237,22 @@ impl Progress {
             ) {
                 b.set_style(style.progress_chars("=> "));
             }
+            // Shown only if the run is still going after a second.
+            let shown = b.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(std::time::Duration::from_secs(1));
+                if !shown.is_finished() {
+                    shown.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+                    shown.enable_steady_tick(std::time::Duration::from_millis(200));
+                }
+            });
             b
         });
-        Self { bar, started }
+        Self { bar }
     }
 
     fn stage(&self, k: u64, msg: &'static str) {
         if let Some(b) = &self.bar {
-            if self.started.elapsed().as_secs_f64() > 1.0 && b.is_hidden() {
-                b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-            }
             b.set_position(k);
             b.set_message(msg);
         }
