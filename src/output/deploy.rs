@@ -244,60 +244,16 @@ pub fn write_deploy(
     }
     dir.write("deployment.csv", c)?;
 
-    let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
-    let series = |f: &dyn Fn(&crate::deploy::Sample, usize) -> f64| -> Vec<Series> {
-        shown
-            .iter()
-            .map(|&i| {
-                (
-                    format!("hinge {}", i + 1),
-                    r.samples.iter().map(|s| (s.t, f(s, i))).collect(),
-                )
-            })
-            .collect()
-    };
-    line_chart(
-        dir,
-        "angles",
-        "opening angles",
-        ("t [s]", "α [rad]"),
-        &series(&|s, i| s.alpha[i]),
-        false,
-    )?;
-    line_chart(
-        dir,
-        "rates",
-        "opening rates",
-        ("t [s]", "α̇ [rad/s]"),
-        &series(&|s, i| s.rate[i]),
-        false,
-    )?;
-    line_chart(
-        dir,
-        "reactions",
-        "hinge reaction force magnitude (inboard body on panel i)",
-        ("t [s]", "|F| [N]"),
-        &series(&|s, i| (s.force[i][0].powi(2) + s.force[i][1].powi(2)).sqrt()),
-        false,
-    )?;
-    let hub: Vec<Series> = ["u [m]", "v [m]", "θ [rad]"]
-        .iter()
-        .enumerate()
-        .map(|(k, l)| {
-            (
-                format!("hub {l}"),
-                r.samples.iter().map(|s| (s.t, s.hub[k])).collect(),
-            )
-        })
-        .collect();
-    line_chart(
-        dir,
-        "hub",
-        "hub motion in the deployment plane",
-        ("t [s]", "u, v [m]; θ [rad]"),
-        &hub,
-        false,
-    )?;
+    for f in super::figures::deployment_figures(d, r) {
+        line_chart(
+            dir,
+            &f.stem,
+            &f.title,
+            (f.xlabel, f.ylabel),
+            &f.series(),
+            false,
+        )?;
+    }
     // Snapshots: the chain at up to 9 evenly spaced sample times (and the final state).
     let m = r.samples.len();
     let picks: Vec<usize> = (0..9).map(|k| k * (m - 1) / 8).collect();

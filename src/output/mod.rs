@@ -3,6 +3,7 @@
 
 mod atomic;
 mod deploy;
+pub mod figures;
 mod modes;
 pub mod plot;
 mod report;

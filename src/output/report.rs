@@ -8,11 +8,11 @@
 //! Every table number that is also in summary.json carries `data-key` (a JSON pointer into
 //! summary.json) and `data-value` (the full-precision value), which the tests compare.
 
+use super::figures::Figure;
 use super::plot::mode_shape_svg;
 use super::OutputError;
 use crate::deploy::chain::PlanarHub;
 use crate::math::Vec3;
-use crate::response::ChannelKind;
 use crate::scenario::Scenario;
 use crate::simulation::Simulation;
 use crate::structure::{HubMotion, Structure};
@@ -53,24 +53,20 @@ fn embed(v: &Value) -> String {
         .replace("</", "<\\/")
 }
 
-/// An interactive chart: series of (x, y) samples.
-fn plot(
-    title: &str,
-    xlabel: &str,
-    ylabel: &str,
-    series: Vec<(String, Vec<f64>, Vec<f64>)>,
-) -> String {
-    let s: Vec<Value> = series
-        .into_iter()
+/// An interactive chart of a figure (data rounded to 7 significant digits).
+fn plot(f: &Figure) -> String {
+    let s: Vec<Value> = f
+        .curves
+        .iter()
         .map(|(name, x, y)| {
-            json!({"name": name, "x": x.into_iter().map(round7).collect::<Vec<_>>(),
-                   "y": y.into_iter().map(round7).collect::<Vec<_>>()})
+            json!({"name": name, "x": x.iter().copied().map(round7).collect::<Vec<_>>(),
+                   "y": y.iter().copied().map(round7).collect::<Vec<_>>()})
         })
         .collect();
-    let spec = json!({"title": title, "xlabel": xlabel, "ylabel": ylabel, "series": s});
+    let spec = json!({"title": f.title, "xlabel": f.xlabel, "ylabel": f.ylabel, "series": s});
     format!(
         "<figure class=\"plot\" data-title=\"{}\"><script type=\"application/json\">{}</script></figure>\n",
-        esc(title),
+        esc(&f.title),
         embed(&spec)
     )
 }
@@ -477,56 +473,9 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
     for w in super::deploy_warnings(d, r) {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w));
     }
-    let n = d.chain.len();
-    let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
-    let t: Vec<f64> = r.samples.iter().map(|s| s.t).collect();
-    let per_hinge = |f: &dyn Fn(&crate::deploy::Sample, usize) -> f64| {
-        shown
-            .iter()
-            .map(|&i| {
-                (
-                    format!("hinge {}", i + 1),
-                    t.clone(),
-                    r.samples.iter().map(|s| f(s, i)).collect(),
-                )
-            })
-            .collect::<Vec<_>>()
-    };
-    o.push_str(&plot(
-        "opening angles",
-        "t [s]",
-        "α [rad]",
-        per_hinge(&|s, i| s.alpha[i]),
-    ));
-    o.push_str(&plot(
-        "opening rates",
-        "t [s]",
-        "α̇ [rad/s]",
-        per_hinge(&|s, i| s.rate[i]),
-    ));
-    o.push_str(&plot(
-        "hinge reaction force magnitude (inboard body on panel i)",
-        "t [s]",
-        "|F| [N]",
-        per_hinge(&|s, i| s.force[i][0].hypot(s.force[i][1])),
-    ));
-    let hub: Vec<(String, Vec<f64>, Vec<f64>)> = ["u [m]", "v [m]", "θ [rad]"]
-        .iter()
-        .enumerate()
-        .map(|(k, l)| {
-            (
-                format!("hub {l}"),
-                t.clone(),
-                r.samples.iter().map(|s| s.hub[k]).collect(),
-            )
-        })
-        .collect();
-    o.push_str(&plot(
-        "hub motion in the deployment plane",
-        "t [s]",
-        "u, v [m]; θ [rad]",
-        hub,
-    ));
+    for f in super::figures::deployment_figures(d, r) {
+        o.push_str(&plot(&f));
+    }
     o.push_str("</section>\n");
     o
 }
@@ -625,91 +574,9 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     for w in &sim.warnings {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(w));
     }
-    let hist = &r.history;
-    let t = hist.times.clone();
-    let pick = |f: &dyn Fn(&crate::response::Channel) -> bool| {
-        r.channels
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| f(c))
-            .map(|(j, c)| {
-                (
-                    c.label.clone(),
-                    t.clone(),
-                    (0..t.len()).map(|k| hist.values[(k, j)]).collect(),
-                )
-            })
-            .collect::<Vec<_>>()
-    };
-    let tl = "t after the latch [s]";
-    for b in &s.structure.beams {
-        let kind = ChannelKind::BeamTip {
-            beam: b.name.clone(),
-        };
-        o.push_str(&plot(
-            &format!(
-                "{} tip: elastic deflection in both bending planes (fig. 2.4)",
-                b.name
-            ),
-            tl,
-            "deflection [m]",
-            pick(&|c| c.kind == kind && c.unit == "m"),
-        ));
-        o.push_str(&plot(
-            &format!("{} tip: elastic twist (fig. 2.4)", b.name),
-            tl,
-            "twist [rad]",
-            pick(&|c| c.kind == kind && c.unit == "rad"),
-        ));
+    for f in super::figures::response_figures(s, r) {
+        o.push_str(&plot(&f));
     }
-    for p in &s.structure.plates {
-        let kind = ChannelKind::PlateTip {
-            plate: p.name.clone(),
-        };
-        o.push_str(&plot(
-            &format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
-            tl,
-            "deflection [m]",
-            pick(&|c| c.kind == kind),
-        ));
-    }
-    o.push_str(&plot(
-        "hub translation along the structure axes (fig. 2.6)",
-        tl,
-        "translation [m]",
-        pick(&|c| c.kind == ChannelKind::HubTranslation),
-    ));
-    o.push_str(&plot(
-        "hub rotation about the structure axes (fig. 2.7)",
-        tl,
-        "rotation [rad]",
-        pick(&|c| c.kind == ChannelKind::HubRotation),
-    ));
-    let modal: Vec<(String, Vec<f64>, Vec<f64>)> = r
-        .modal
-        .modes
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| !m.rigid)
-        .take(8)
-        .map(|(j, m)| {
-            (
-                format!(
-                    "mode {} ({:.3} Hz)",
-                    m.number,
-                    m.omega / (2.0 * std::f64::consts::PI)
-                ),
-                t.clone(),
-                (0..t.len()).map(|k| hist.modal[(k, j)]).collect(),
-            )
-        })
-        .collect();
-    o.push_str(&plot(
-        "modal amplitudes of the first elastic modes",
-        tl,
-        "η [√kg·m]",
-        modal,
-    ));
     o.push_str("</section>\n");
     o
 }

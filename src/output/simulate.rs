@@ -1,7 +1,7 @@
 //! `flexcraft simulate` outputs: the terminal summary, summary.json, response.csv and the
 //! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
 
-use super::plot::{line_chart, Series};
+use super::plot::line_chart;
 use super::{deploy_table, modes_json, write_deploy, OutputDir, OutputError};
 use crate::math::Vec3;
 use crate::response::ChannelKind;
@@ -339,105 +339,15 @@ pub fn write_simulate(
     }
     dir.write("response.csv", c)?;
 
-    let series = |pick: &dyn Fn(&crate::response::Channel) -> bool| -> Vec<Series> {
-        r.channels
-            .iter()
-            .enumerate()
-            .filter(|(_, ch)| pick(ch))
-            .map(|(j, ch)| {
-                (
-                    ch.label.clone(),
-                    hist.times
-                        .iter()
-                        .enumerate()
-                        .map(|(k, &t)| (t, hist.values[(k, j)]))
-                        .collect(),
-                )
-            })
-            .collect()
-    };
-    for b in &s.structure.beams {
-        let kind = ChannelKind::BeamTip {
-            beam: b.name.clone(),
-        };
+    for f in super::figures::response_figures(s, r) {
         line_chart(
             dir,
-            &format!("response_{}_tip", b.name),
-            &format!(
-                "{} tip: elastic deflection in both bending planes (fig. 2.4)",
-                b.name
-            ),
-            ("t after the latch [s]", "deflection [m]"),
-            &series(&|ch| ch.kind == kind && ch.unit == "m"),
-            false,
-        )?;
-        line_chart(
-            dir,
-            &format!("response_{}_twist", b.name),
-            &format!("{} tip: elastic twist (fig. 2.4)", b.name),
-            ("t after the latch [s]", "twist [rad]"),
-            &series(&|ch| ch.kind == kind && ch.unit == "rad"),
+            &f.stem,
+            &f.title,
+            (f.xlabel, f.ylabel),
+            &f.series(),
             false,
         )?;
     }
-    for p in &s.structure.plates {
-        let kind = ChannelKind::PlateTip {
-            plate: p.name.clone(),
-        };
-        line_chart(
-            dir,
-            &format!("response_{}_tip", p.name),
-            &format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
-            ("t after the latch [s]", "deflection [m]"),
-            &series(&|ch| ch.kind == kind),
-            false,
-        )?;
-    }
-    line_chart(
-        dir,
-        "response_hub_translation",
-        "hub translation along the structure axes (fig. 2.6)",
-        ("t after the latch [s]", "translation [m]"),
-        &series(&|ch| ch.kind == ChannelKind::HubTranslation),
-        false,
-    )?;
-    line_chart(
-        dir,
-        "response_hub_rotation",
-        "hub rotation about the structure axes (fig. 2.7)",
-        ("t after the latch [s]", "rotation [rad]"),
-        &series(&|ch| ch.kind == ChannelKind::HubRotation),
-        false,
-    )?;
-    let modal: Vec<Series> = r
-        .modal
-        .modes
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| !m.rigid)
-        .take(8)
-        .map(|(j, m)| {
-            (
-                format!(
-                    "mode {} ({:.3} Hz)",
-                    m.number,
-                    m.omega / (2.0 * std::f64::consts::PI)
-                ),
-                hist.times
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &t)| (t, hist.modal[(k, j)]))
-                    .collect(),
-            )
-        })
-        .collect();
-    line_chart(
-        dir,
-        "response_modal_amplitudes",
-        "modal amplitudes of the first elastic modes",
-        ("t after the latch [s]", "η [√kg·m]"),
-        &modal,
-        false,
-    )?;
     Ok(())
 }
