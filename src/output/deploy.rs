@@ -1,7 +1,7 @@
 //! Deployment outputs: event table, JSON, deployment.csv, events.json and plots.
 
 use super::plot::{line_chart, Series};
-use super::{OutputDir, OutputError};
+use super::{num, OutputDir, OutputError};
 use crate::deploy::chain::PlanarHub;
 use crate::deploy::{Deployment, DeploymentResult, Latching};
 use serde_json::{json, Value};
@@ -189,10 +189,6 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
         let _ = writeln!(s, "warning: {w}");
     }
     s
-}
-
-fn num(v: f64) -> String {
-    format!("{v:e}")
 }
 
 /// Writes deployment.csv, events.json and plots/*.{png,svg}.

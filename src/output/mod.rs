@@ -17,6 +17,11 @@ pub use simulate::{simulate_json, simulate_table, write_simulate};
 
 use thiserror::Error;
 
+/// A CSV number: the shortest representation that reads back to the same f64.
+fn num(v: f64) -> String {
+    format!("{v:e}")
+}
+
 /// Failure to write an output.
 #[derive(Debug, Error)]
 pub enum OutputError {

@@ -2,7 +2,7 @@
 //! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
 
 use super::plot::line_chart;
-use super::{deploy_table, modes_json, write_deploy, OutputDir, OutputError};
+use super::{deploy_table, modes_json, num, write_deploy, OutputDir, OutputError};
 use crate::math::Vec3;
 use crate::response::ChannelKind;
 use crate::scenario::Scenario;
@@ -288,10 +288,6 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         let _ = writeln!(o, "warning: {w}");
     }
     o
-}
-
-fn num(v: f64) -> String {
-    format!("{v:e}")
 }
 
 /// Writes summary.json, report.html, modes.json, the deployment's files, response.csv and
