@@ -262,7 +262,7 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
     let mut o = String::from("<section id=\"modes\"><h2>Modes</h2>\n");
     let _ = writeln!(
         o,
-        "<p class=\"note\">{} generalized coordinates, basis {}, hub {}. SE: strain-energy share of each component. Effective masses of the hub-fixed elastic modes (kg; base-excitation measure) are listed for a fixed hub.</p>",
+        "<p class=\"note\">{} generalized coordinates, basis {}, hub {}. SE: strain-energy share of each component. Effective masses (kg; base-excitation measure) are those of the hub-fixed elastic modes: in the table for a fixed hub, below it for a free one.</p>",
         sim.modes.dof,
         st.basis.name(),
         if st.hub.motion == HubMotion::Free { "free" } else { "fixed" }
@@ -331,6 +331,33 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
             o,
             "<p class=\"note\">… {} more modes in modes.json.</p>",
             sim.modes.modes.len() - 30
+        );
+    }
+    if st.hub.motion == HubMotion::Free {
+        // A free hub's elastic modes carry no base-excitation effective mass; the standard
+        // measure is that of the hub-fixed modes.
+        o.push_str("<h3>Effective masses of the hub-fixed elastic modes</h3><table id=\"effective-masses\"><tr><th>mode</th><th>f [Hz]</th><th>x [kg]</th><th>y [kg]</th><th>z [kg]</th><th>rx [kg·m²]</th><th>ry [kg·m²]</th><th>rz [kg·m²]</th></tr>\n");
+        for (i, m) in sim.modes.hub_fixed.iter().take(12).enumerate() {
+            let _ = write!(
+                o,
+                "<tr><td>{}</td><td>{:.6}</td>",
+                i + 1,
+                m.omega_rad_s / (2.0 * std::f64::consts::PI)
+            );
+            for v in m.effective_mass {
+                let _ = write!(o, "<td>{v:.4e}</td>");
+            }
+            o.push_str("</tr>\n");
+        }
+        let _ = writeln!(
+            o,
+            "</table><p class=\"note\">Appendage rigid mass (the limit of the sums): {}.</p>",
+            sim.modes
+                .appendage_mass
+                .iter()
+                .map(|v| format!("{v:.4e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     // Mode shapes: the first six elastic modes.
