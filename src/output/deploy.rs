@@ -241,14 +241,7 @@ pub fn write_deploy(
     dir.write("deployment.csv", c)?;
 
     for f in super::figures::deployment_figures(d, r) {
-        line_chart(
-            dir,
-            &f.stem,
-            &f.title,
-            (f.xlabel, f.ylabel),
-            &f.series(),
-            false,
-        )?;
+        f.draw(dir)?;
     }
     // Snapshots: the chain at up to 9 evenly spaced sample times (and the final state).
     let m = r.samples.len();

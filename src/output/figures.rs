@@ -25,6 +25,18 @@ pub struct Figure {
 }
 
 impl Figure {
+    /// plots/STEM.png and .svg.
+    pub fn draw(&self, dir: &mut super::OutputDir) -> Result<(), super::OutputError> {
+        super::plot::line_chart(
+            dir,
+            &self.stem,
+            &self.title,
+            (self.xlabel, self.ylabel),
+            &self.series(),
+            false,
+        )
+    }
+
     /// (x, y) pairs of every curve, for plotters.
     pub fn series(&self) -> Vec<super::plot::Series> {
         self.curves

@@ -1,7 +1,6 @@
 //! `flexcraft simulate` outputs: the terminal summary, summary.json, response.csv and the
 //! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
 
-use super::plot::line_chart;
 use super::{deploy_table, modes_json, num, write_deploy, OutputDir, OutputError};
 use crate::math::Vec3;
 use crate::response::ChannelKind;
@@ -336,14 +335,7 @@ pub fn write_simulate(
     dir.write("response.csv", c)?;
 
     for f in super::figures::response_figures(s, r) {
-        line_chart(
-            dir,
-            &f.stem,
-            &f.title,
-            (f.xlabel, f.ylabel),
-            &f.series(),
-            false,
-        )?;
+        f.draw(dir)?;
     }
     Ok(())
 }
