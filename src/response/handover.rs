@@ -105,6 +105,7 @@ pub struct Handover {
 
 /// The deploying plate's place in the model.
 struct PlateView<'a> {
+    index: usize,
     plate: &'a Plate,
     element: &'a Element,
     xb: &'a dyn Basis1d,
@@ -126,6 +127,7 @@ impl<'a> PlateView<'a> {
             return Err(ResponseError::UnknownPlate(name.to_string()));
         };
         Ok(Self {
+            index: idx,
             plate: &model.structure.plates[idx],
             element,
             xb: length.as_ref(),
@@ -446,18 +448,12 @@ pub fn hand_over(
         }
         HandoverMethod::Impulse => {
             let (s, c) = pl.theta.sin_cos();
-            let pi = model
-                .structure
-                .plates
-                .iter()
-                .position(|p| p.name == deployment.plate)
-                .ok_or_else(|| ResponseError::UnknownPlate(deployment.plate.clone()))?;
             for (i, p) in pl.panels.iter().enumerate() {
                 let sp = last.impulses[i].0;
                 let imp = ea * (c * sp[0] + s * sp[1]) + nn * (-s * sp[0] + c * sp[1]);
                 let bi = point_impulse(
                     model,
-                    ComponentId::Plate(pi),
+                    ComponentId::Plate(view.index),
                     [p.start + 0.5 * p.length, 0.0],
                     imp,
                 );
