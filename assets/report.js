@@ -67,6 +67,7 @@
         var c = 0.5 * (ylo + yhi), d = Math.max(Math.abs(c) * 0.1, 1e-12); ylo = c - d; yhi = c + d;
       }
       var pad = 0.05 * (yhi - ylo); ylo -= pad; yhi += pad;
+      fig.setAttribute("data-view", view[0] + "," + view[1]);
       var sx = function (x) { return L + (x - view[0]) / (view[1] - view[0] || 1) * (W - L - R); };
       var sy = function (y) { return H - B - (y - ylo) / (yhi - ylo) * (H - T - B); };
       chart.sx = sx; chart.sy = sy;
@@ -182,4 +183,26 @@
   document.querySelectorAll("figure.plot").forEach(function (f) { Chart(f, data(f)); });
   document.querySelectorAll(".animation").forEach(function (a) { Animation(a, data(a)); });
   if (status === "ok") document.body.setAttribute("data-status", "ok");
+  // #selftest: hover and drag-zoom the first chart with synthetic mouse events (the browser
+  // test reads the verdict from body[data-selftest]).
+  if (/selftest/.test(location.hash)) {
+    var verdict = "ok";
+    try {
+      var fig = document.querySelector("figure.plot");
+      var svg = fig.querySelector("svg");
+      var r = svg.getBoundingClientRect();
+      var at = function (type, fx) {
+        svg.dispatchEvent(new MouseEvent(type, { clientX: r.left + fx * r.width, clientY: r.top + 0.5 * r.height, bubbles: true }));
+      };
+      var span = function () { var v = fig.getAttribute("data-view").split(",").map(Number); return v[1] - v[0]; };
+      var full = span();
+      at("mousemove", 0.5);
+      if (!fig.querySelector(".tip").textContent) verdict = "no hover readout";
+      at("mousedown", 0.3); at("mousemove", 0.6); at("mouseup", 0.6);
+      if (!(span() < 0.5 * full)) verdict = "drag did not zoom";
+      svg.dispatchEvent(new MouseEvent("dblclick", { bubbles: true }));
+      if (span() !== full) verdict = "double-click did not reset";
+    } catch (e) { verdict = "error: " + e.message; }
+    document.body.setAttribute("data-selftest", verdict);
+  }
 })();

@@ -123,8 +123,9 @@ fn pixels(path: &Path) -> Vec<u8> {
         .into_raw()
 }
 
-/// Headless Chromium: the page runs without a script error, its screenshot is not blank,
-/// and the animation's first and last frames differ. Needs `chromium` (.ci/run installs
+/// Headless Chromium: the page runs without a script error, hovering a chart shows a
+/// readout and dragging zooms it, its screenshot is not blank, and the animation's first and
+/// last frames differ. Needs `chromium` (.ci/run installs
 /// Debian's package): `cargo test --release -- --ignored browser`.
 #[test]
 #[ignore]
@@ -160,6 +161,22 @@ fn browser_renders_the_report_without_errors_and_animates() {
         "script error or no run: {}",
         dom.find("data-status")
             .map_or("no status", |i| &dom[i..i + 80])
+    );
+    // Hover and drag-zoom, driven by the page's own #selftest with synthetic mouse events.
+    let dom = Command::new(chromium)
+        .args(base)
+        .arg(profile("selftest"))
+        .arg("--window-size=1280,1600")
+        .arg("--dump-dom")
+        .arg(format!("{page}#selftest"))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert!(
+        dom.contains("data-selftest=\"ok\""),
+        "interaction self-test: {}",
+        dom.find("data-selftest")
+            .map_or("not run", |i| &dom[i..(i + 80).min(dom.len())])
     );
     let mut shots = Vec::new();
     for frame in ["0", "last"] {
