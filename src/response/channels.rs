@@ -112,27 +112,34 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
             _ => {}
         }
     }
-    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-        let mut row = vec![0.0; n];
-        row[k] = 1.0;
-        out.push(Channel {
-            name: format!("hub_{axis}"),
-            label: format!("hub translation {axis}"),
-            unit: "m",
-            kind: ChannelKind::HubTranslation,
-            row,
-        });
-    }
-    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
-        let mut row = vec![0.0; n];
-        row[3 + k] = 1.0;
-        out.push(Channel {
-            name: format!("hub_rot_{axis}"),
-            label: format!("hub rotation about {axis}"),
-            unit: "rad",
-            kind: ChannelKind::HubRotation,
-            row,
-        });
+    // Hub coordinates 0–2 (translation of its centre of mass) and 3–5 (small rotation).
+    for (first, name, label, unit, kind) in [
+        (
+            0,
+            "hub_",
+            "hub translation ",
+            "m",
+            ChannelKind::HubTranslation,
+        ),
+        (
+            3,
+            "hub_rot_",
+            "hub rotation about ",
+            "rad",
+            ChannelKind::HubRotation,
+        ),
+    ] {
+        for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+            let mut row = vec![0.0; n];
+            row[first + k] = 1.0;
+            out.push(Channel {
+                name: format!("{name}{axis}"),
+                label: format!("{label}{axis}"),
+                unit,
+                kind: kind.clone(),
+                row,
+            });
+        }
     }
     out
 }

@@ -86,7 +86,8 @@ pub struct Handover {
     /// structure's rigid parts moving with the hub, J.
     pub energy_before: f64,
     /// The same from the plate's own density field (the quantity the projection conserves or
-    /// lowers; equal to `energy_before` when the panels' masses are the plate's), J.
+    /// lowers; equal to `energy_before` when the panels' masses are the plate's), J. The
+    /// impulse route does not use the field and repeats `energy_before` here.
     pub energy_before_field: f64,
     /// Kinetic energy after the hand-over, ½Σ η̇_j², J.
     pub energy_after: f64,
