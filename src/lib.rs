@@ -18,6 +18,7 @@
 
 pub mod basis;
 pub mod deploy;
+pub mod finite;
 pub mod math;
 pub mod output;
 pub mod response;

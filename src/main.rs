@@ -116,6 +116,35 @@ fn need_deployment<'a>(path: &Path, s: &'a Scenario) -> Result<&'a Deployment, E
     })
 }
 
+/// A result with a NaN or an infinity is an error naming the quantity, never printed.
+fn not_finite(path: &Path, r: Result<(), flexcraft::finite::NonFinite>) -> Result<(), ExitCode> {
+    r.map_err(|e| {
+        eprintln!("error: {}: {e}", path.display());
+        ExitCode::from(FAILED)
+    })
+}
+
+/// A failed modal solve, reported at the component it is traced to (exit status 1).
+fn numerical_failure(
+    scenario: &Scenario,
+    model: &RitzModel,
+    e: &flexcraft::ritz::RitzError,
+) -> ExitCode {
+    let id = model.culprit(e);
+    let name = scenario.structure.component_name(id);
+    eprintln!(
+        "error: {}",
+        scenario.locate(
+            id,
+            format!(
+                "{e}; traced to component \"{name}\": check its values against the others \
+                 (masses, stiffnesses and sizes that differ by many orders of magnitude)"
+            )
+        )
+    );
+    ExitCode::from(FAILED)
+}
+
 /// Prints the JSON object or the table, then writes the output directory (staged, renamed
 /// when complete) with `write`.
 fn finish(
@@ -150,10 +179,9 @@ fn finish(
 fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
     let scenario = load(path)?;
     let model = RitzModel::assemble(&scenario.structure);
-    let modes = ModalAnalysis::compute(&model).map_err(|e| {
-        eprintln!("error: {}: {e}", path.display());
-        ExitCode::from(FAILED)
-    })?;
+    let modes =
+        ModalAnalysis::compute(&model).map_err(|e| numerical_failure(&scenario, &model, &e))?;
+    not_finite(path, flexcraft::finite::check_modes(&modes))?;
     finish(
         json,
         || output::modes_json(&model, &modes),
@@ -167,6 +195,7 @@ fn run_deploy(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCod
     let scenario = load(path)?;
     let d = need_deployment(path, &scenario)?;
     let result = flexcraft::deploy::simulate(d);
+    not_finite(path, flexcraft::finite::check_deployment(&result))?;
     finish(
         json,
         || output::deploy_json(&scenario.name, d, &result),
@@ -190,10 +219,16 @@ fn run_simulate(
     need_deployment(path, &scenario)?;
     let source = std::fs::read(path).unwrap_or_default();
     progress.stage(1, "modes, deployment, hand-over, response");
-    let sim = Simulation::run(&scenario).map_err(|e| {
-        eprintln!("error: {}: {e}", path.display());
-        ExitCode::from(FAILED)
+    let sim = Simulation::run(&scenario).map_err(|e| match &e {
+        flexcraft::simulation::SimulationError::Ritz(r) => {
+            numerical_failure(&scenario, &RitzModel::assemble(&scenario.structure), r)
+        }
+        _ => {
+            eprintln!("error: {}: {e}", path.display());
+            ExitCode::from(FAILED)
+        }
     })?;
+    not_finite(path, flexcraft::finite::check_simulation(&sim))?;
     progress.stage(2, "writing outputs");
     let file_name = path
         .file_name()

@@ -43,9 +43,14 @@ impl Vec3 {
         self.dot(self).sqrt()
     }
 
-    /// This vector divided by its norm.
+    /// This vector divided by its norm, computed scale-safely: the vector is first divided
+    /// by its largest component's magnitude, so that no square overflows or underflows
+    /// (`[0, 0, 1e200]` and `[0, 0, 1e-310]` both give `[0, 0, 1]`). The zero vector gives
+    /// NaN components; callers check for it.
     pub fn normalized(self) -> Vec3 {
-        self * (1.0 / self.norm())
+        let big = self.0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let s = self * (1.0 / big);
+        s * (1.0 / s.norm())
     }
 
     /// Component i.

@@ -123,7 +123,16 @@ pub struct DeploymentResult {
     pub evaluations: usize,
     /// The integration produced a non-finite state and was stopped there.
     pub diverged: bool,
+    /// The run took [`MAX_STEPS`] steps and was stopped at `final_time` before its end
+    /// (a stiff or badly scaled problem; the result up to there is valid).
+    pub step_limit_reached: bool,
 }
+
+/// Most integration steps one deployment run may take. A deterministic guard (a wall-time
+/// limit would make the result depend on the machine): a run of accepted values that would
+/// take longer stops with [`DeploymentResult::step_limit_reached`], never hangs. The seed
+/// example takes a few thousand steps.
+pub const MAX_STEPS: usize = 1_000_000;
 
 struct System<'a> {
     chain: &'a Chain,
@@ -190,7 +199,6 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
     let mut buf = vec![0.0; 2 * n];
     let mut steps = 0usize;
     let mut diverged = false;
-    let max_steps = 50_000_000usize;
 
     let check_swing = |swing: &mut Vec<Option<SwingBack>>, t: f64, alpha: &[f64]| {
         for (i, a) in alpha.iter().enumerate() {
@@ -210,7 +218,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         }
     };
 
-    while t < d.end_time && sys.free[h..].iter().any(|f| *f) && steps < max_steps {
+    while t < d.end_time && sys.free[h..].iter().any(|f| *f) && steps < MAX_STEPS {
         steps += 1;
         let t_start = t;
         let y_start = y.clone();
@@ -359,6 +367,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         unlatched,
         swing_back: swing.into_iter().flatten().collect(),
         evaluations: solver.evaluations,
+        step_limit_reached: steps >= MAX_STEPS && !diverged && t < d.end_time && !all_latched,
         diverged,
     }
 }

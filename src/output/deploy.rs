@@ -34,6 +34,14 @@ pub fn deploy_warnings(d: &Deployment, r: &DeploymentResult) -> Vec<String> {
             r.final_time
         ));
     }
+    if r.step_limit_reached {
+        w.push(format!(
+            "step limit reached at t = {} s: the integration took {} steps and was stopped \
+             there (a stiff or badly scaled deployment; the results up to t are valid)",
+            r.final_time,
+            crate::deploy::MAX_STEPS
+        ));
+    }
     if !r.all_latched {
         let list: Vec<String> = r
             .unlatched

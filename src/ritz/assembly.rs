@@ -227,6 +227,36 @@ impl RitzModel {
     pub fn element(&self, id: ComponentId) -> Option<&Element> {
         self.elements.iter().find(|e| e.id == id)
     }
+
+    /// The component that owns generalized coordinate `dof` (the hub's six first).
+    pub fn component_at(&self, dof: usize) -> ComponentId {
+        self.elements
+            .iter()
+            .find(|e| e.own_range().contains(&dof))
+            .map_or(ComponentId::Hub, |e| e.id)
+    }
+
+    /// The component a failed solve is traced to: the coordinate of the failing pivot, or,
+    /// for an eigensolver that did not converge, the coordinate with the most extreme
+    /// stiffness-to-mass ratio (the usual cause: values that spread over too many decades).
+    pub fn culprit(&self, e: &super::RitzError) -> ComponentId {
+        match e {
+            super::RitzError::MassNotPositiveDefinite { pivot } => self.component_at(*pivot),
+            super::RitzError::EigenNoConvergence => {
+                let n = self.dof();
+                let ratio = |i: usize| {
+                    let r = self.stiffness[(i, i)] / self.mass[(i, i)];
+                    if r.is_finite() {
+                        r.abs()
+                    } else {
+                        f64::INFINITY
+                    }
+                };
+                let worst = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
+                self.component_at(worst)
+            }
+        }
+    }
 }
 
 fn symmetrize(m: &mut Mat<f64>) {

@@ -57,20 +57,44 @@ pub struct ScenarioError {
     pub reason: String,
 }
 
+/// Longest key shown in a message, characters.
+pub const MAX_KEY_CHARS: usize = 80;
+/// Longest reason shown in a message, characters (about one screen line or three).
+pub const MAX_REASON_CHARS: usize = 240;
+
+/// `s` cut to at most `max` characters, with an ellipsis when cut; control characters shown
+/// as escapes so a message stays on one line.
+pub fn truncate(s: &str, max: usize) -> String {
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i == max {
+            out.push('…');
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 impl std::fmt::Display for ScenarioError {
-    /// `file:line:column: key: reason`, or `file: reason` when the file could not be read.
+    /// `file:line:column: key: reason`, or `file: reason` when the file could not be read;
+    /// keys and reasons are cut to one screen ([`MAX_KEY_CHARS`], [`MAX_REASON_CHARS`]).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let reason = truncate(&self.reason, MAX_REASON_CHARS);
         if self.kind == ErrorKind::Io {
-            write!(
-                f,
-                "{}: cannot read the scenario: {}",
-                self.file, self.reason
-            )
+            write!(f, "{}: cannot read the scenario: {reason}", self.file)
         } else {
             write!(
                 f,
-                "{}:{}:{}: {}: {}",
-                self.file, self.location.line, self.location.column, self.key, self.reason
+                "{}:{}:{}: {}: {reason}",
+                self.file,
+                self.location.line,
+                self.location.column,
+                truncate(&self.key, MAX_KEY_CHARS)
             )
         }
     }

@@ -2,18 +2,23 @@
 //! validation with the location of every refused value, and construction of the
 //! [`Structure`].
 
+mod budget;
 mod error;
+pub mod limits;
 mod raw;
 
+pub use budget::{format_bytes, Estimate};
 pub use error::{ErrorKind, Location, ScenarioError};
 
 use crate::deploy::{Deployment, Latching};
 use crate::math::Vec3;
 use crate::response::{HandoverMethod, ResponseSettings};
 use crate::structure::{
-    inertia_tensor, Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass,
+    inertia_tensor, Attachment, ComponentId, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass,
     Material, Plate, PlateTerms, Structure, StructureError,
 };
+use limits::Limit;
+use limits as L;
 use raw::*;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -29,7 +34,58 @@ pub struct Scenario {
     pub deployment: Option<Deployment>,
     /// The `[response]` settings (defaults when the section is absent).
     pub response: ResponseSettings,
+    /// Where each component was written, to locate a failure found after parsing.
+    sources: Sources,
 }
+
+/// The file and the place each component was written (its `name` key; the `[hub]` table).
+#[derive(Debug, Clone, Default)]
+struct Sources {
+    file: String,
+    at: BTreeMap<ComponentId, (String, Location)>,
+    /// Keys located after parsing (`response.output_rate`, …): the value, or its section.
+    keys: BTreeMap<&'static str, Location>,
+}
+
+impl Scenario {
+    /// A failure found after parsing (a numerical one, e.g. a mass matrix that is not
+    /// positive definite) located at the component it was traced to: `file:line:column:
+    /// key: reason`, with the component's key (`beams[0]`, `hub`, …).
+    pub fn locate(&self, component: ComponentId, reason: impl Into<String>) -> ScenarioError {
+        let (key, location) = self
+            .sources
+            .at
+            .get(&component)
+            .cloned()
+            .unwrap_or_else(|| ("(structure)".into(), Location { line: 1, column: 1 }));
+        ScenarioError {
+            kind: ErrorKind::Invalid,
+            file: self.sources.file.clone(),
+            location,
+            key,
+            reason: reason.into(),
+        }
+    }
+
+    /// Like [`Scenario::locate`], for one of the keys the run checks after parsing.
+    fn locate_key(&self, key: &'static str, reason: impl Into<String>) -> ScenarioError {
+        ScenarioError {
+            kind: ErrorKind::Invalid,
+            file: self.sources.file.clone(),
+            location: self
+                .sources
+                .keys
+                .get(key)
+                .copied()
+                .unwrap_or(Location { line: 1, column: 1 }),
+            key: key.to_string(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Largest scenario file read, bytes (16 MiB).
+pub const MAX_SCENARIO_BYTES: u64 = 16 << 20;
 
 /// Default number of Ritz functions (bending, torsion, axial) of a beam.
 pub const DEFAULT_BEAM_TERMS: (usize, usize, usize) = (8, 6, 4);
@@ -76,25 +132,115 @@ impl Ctx<'_> {
         r.map_err(|e| self.invalid(span, key, e.to_string()))
     }
 
-    fn positive(&self, v: &S<f64>, key: impl Into<String>) -> Result<f64, ScenarioError> {
+    /// A scalar inside its accepted range ([`limits`]).
+    fn bounded(&self, v: &S<f64>, key: impl Into<String>, lim: Limit) -> Result<f64, ScenarioError> {
         let x = *v.get_ref();
-        if x.is_finite() && x > 0.0 {
+        if lim.contains(x) {
             Ok(x)
         } else {
             Err(self.invalid(
                 v.span(),
                 key,
-                format!("must be a positive finite number, got {x}"),
+                format!("must lie in {}, got {x:e}", lim.describe()),
             ))
         }
     }
 
-    fn vec3(&self, v: &S<[f64; 3]>, key: impl Into<String>) -> Result<Vec3, ScenarioError> {
+    /// An optional scalar inside its range, or `default` when absent.
+    fn bounded_or(
+        &self,
+        v: &Option<S<f64>>,
+        default: f64,
+        key: impl Into<String>,
+        lim: Limit,
+    ) -> Result<f64, ScenarioError> {
+        match v {
+            Some(x) => self.bounded(x, key, lim),
+            None => Ok(default),
+        }
+    }
+
+    /// A component or material name: [`limits::valid_name`]'s rule, checked once here.
+    fn name(&self, v: &S<String>, key: impl Into<String>) -> Result<String, ScenarioError> {
+        let n = v.get_ref();
+        match L::valid_name(n) {
+            Ok(()) => Ok(n.clone()),
+            Err(why) => Err(self.invalid(v.span(), key, why)),
+        }
+    }
+
+    /// An inertia given as 3 principal or 6 values: each entry in range, then a physical
+    /// tensor ([`inertia_tensor`]).
+    fn inertia(
+        &self,
+        v: &S<Vec<f64>>,
+        key: impl Into<String>,
+    ) -> Result<crate::math::Mat3, ScenarioError> {
+        let key = key.into();
+        let vals = v.get_ref();
+        for (i, x) in vals.iter().enumerate() {
+            let diagonal = i < 3;
+            let ok = L::INERTIA.contains(*x)
+                && (!diagonal || x.abs() >= L::MIN_PRINCIPAL_INERTIA);
+            if !ok {
+                return Err(self.invalid(
+                    v.span(),
+                    key,
+                    format!(
+                        "entry {} is {x:e}: moments must lie in [{:e}, {:e}] kg·m², products in {}",
+                        i + 1,
+                        L::MIN_PRINCIPAL_INERTIA,
+                        L::INERTIA.hi,
+                        L::INERTIA.describe()
+                    ),
+                ));
+            }
+        }
+        self.structural(inertia_tensor(vals), v.span(), key)
+    }
+
+    /// Poisson's ratio in (−1, 0.5).
+    fn poisson(&self, v: &S<f64>, key: impl Into<String>) -> Result<f64, ScenarioError> {
+        let nu = *v.get_ref();
+        if L::POISSON.contains(nu) && nu < 0.5 {
+            Ok(nu)
+        } else {
+            Err(self.invalid(v.span(), key, format!("must lie in (-1, 0.5), got {nu}")))
+        }
+    }
+
+    /// A point or offset: every coordinate inside [`limits::COORDINATE`].
+    fn point(&self, v: &S<[f64; 3]>, key: impl Into<String>) -> Result<Vec3, ScenarioError> {
         let a = *v.get_ref();
-        if a.iter().all(|x| x.is_finite()) {
+        if a.iter().all(|x| limits::COORDINATE.contains(*x)) {
             Ok(Vec3(a))
         } else {
-            Err(self.invalid(v.span(), key, "every component must be finite"))
+            Err(self.invalid(
+                v.span(),
+                key,
+                format!(
+                    "every coordinate must lie in {}, got [{:e}, {:e}, {:e}]",
+                    limits::COORDINATE.describe(),
+                    a[0],
+                    a[1],
+                    a[2]
+                ),
+            ))
+        }
+    }
+
+    /// A direction: finite components, not all zero (any scale: it is normalised
+    /// scale-safely by the structure).
+    fn direction(&self, v: &S<[f64; 3]>, key: impl Into<String>) -> Result<Vec3, ScenarioError> {
+        let a = *v.get_ref();
+        if a.iter().all(|x| x.is_finite()) && a.iter().any(|x| *x != 0.0) {
+            Ok(Vec3(a))
+        } else {
+            Err(self.invalid(
+                v.span(),
+                key,
+                "a direction needs finite components, not all zero",
+            ))
         }
     }
 
@@ -157,14 +303,39 @@ fn key_at(src: &str, offset: usize) -> String {
 impl Scenario {
     /// Reads and validates a scenario file.
     pub fn from_file(path: &std::path::Path) -> Result<Self, ScenarioError> {
+        use std::io::Read;
         let file = path.display().to_string();
-        let src = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        let io = |reason: String| ScenarioError {
             kind: ErrorKind::Io,
             file: file.clone(),
             location: Location { line: 0, column: 0 },
             key: "(file)".into(),
-            reason: e.to_string(),
-        })?;
+            reason,
+        };
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes))
+            .map_err(|e| io(e.to_string()))?;
+        if bytes.len() as u64 > MAX_SCENARIO_BYTES {
+            return Err(io(format!(
+                "the file is larger than {} MiB; a scenario is a small text file",
+                MAX_SCENARIO_BYTES >> 20
+            )));
+        }
+        let src = match String::from_utf8(bytes) {
+            Ok(s) => s,
+            Err(e) => {
+                let good = e.utf8_error().valid_up_to();
+                let text = String::from_utf8_lossy(&e.as_bytes()[..good]).into_owned();
+                return Err(ScenarioError {
+                    kind: ErrorKind::Syntax,
+                    file: file.clone(),
+                    location: Location::of_offset(&text, good),
+                    key: key_at(&text, good),
+                    reason: "the file is not valid UTF-8 here (TOML is UTF-8 text)".into(),
+                });
+            }
+        };
         Self::from_toml_str(&src, &file)
     }
 
@@ -216,28 +387,26 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             ));
         }
     }
-    let name = raw
-        .name
-        .as_ref()
-        .map_or_else(|| "unnamed".to_string(), |n| n.get_ref().clone());
+    let name = match &raw.name {
+        None => "unnamed".to_string(),
+        Some(n) => match L::valid_title(n.get_ref()) {
+            Ok(()) => n.get_ref().clone(),
+            Err(why) => return Err(cx.invalid(n.span(), "name", why)),
+        },
+    };
 
     // Materials.
     let mut materials: BTreeMap<&str, Material> = BTreeMap::new();
     for (mname, m) in &raw.materials {
-        let k = format!("materials.{mname}");
-        let e = cx.positive(&m.get_ref().youngs_modulus, format!("{k}.youngs_modulus"))?;
-        let rho = cx.positive(&m.get_ref().density, format!("{k}.density"))?;
-        let nu_s = &m.get_ref().poisson_ratio;
-        let nu = *nu_s.get_ref();
-        if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-            return Err(cx.invalid(
-                nu_s.span(),
-                format!("{k}.poisson_ratio"),
-                format!("must lie in (-1, 0.5), got {nu}"),
-            ));
+        if let Err(why) = L::valid_name(mname) {
+            return Err(cx.invalid(m.span(), "materials", format!("material name: {why}")));
         }
+        let k = format!("materials.{mname}");
+        let e = cx.bounded(&m.get_ref().youngs_modulus, format!("{k}.youngs_modulus"), L::MODULUS)?;
+        let rho = cx.bounded(&m.get_ref().density, format!("{k}.density"), L::DENSITY)?;
+        let nu = cx.poisson(&m.get_ref().poisson_ratio, format!("{k}.poisson_ratio"))?;
         let g = match &m.get_ref().shear_modulus {
-            Some(g) => Some(cx.positive(g, format!("{k}.shear_modulus"))?),
+            Some(g) => Some(cx.bounded(g, format!("{k}.shear_modulus"), L::MODULUS)?),
             None => None,
         };
         let mat = cx.structural(Material::new(e, nu, rho, g), m.span(), k)?;
@@ -285,9 +454,9 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             }
             let c = shape.get_ref().cylinder.get_ref();
             let k = "hub.shape.cylinder";
-            let d = cx.positive(&c.diameter, format!("{k}.diameter"))?;
-            let w = cx.positive(&c.wall, format!("{k}.wall"))?;
-            let l = cx.positive(&c.length, format!("{k}.length"))?;
+            let d = cx.bounded(&c.diameter, format!("{k}.diameter"), L::LENGTH)?;
+            let w = cx.bounded(&c.wall, format!("{k}.wall"), L::SECTION)?;
+            let l = cx.bounded(&c.length, format!("{k}.length"), L::LENGTH)?;
             if w >= d / 2.0 {
                 return Err(cx.invalid(
                     c.wall.span(),
@@ -295,8 +464,8 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                     format!("wall {w} m is not less than the radius {} m", d / 2.0),
                 ));
             }
-            let axis = cx.vec3(&c.axis, format!("{k}.axis"))?;
-            let center = cx.vec3(&c.center, format!("{k}.center"))?;
+            let axis = cx.direction(&c.axis, format!("{k}.axis"))?;
+            let center = cx.point(&c.center, format!("{k}.center"))?;
             let mat = material(&c.material, format!("{k}.material"))?;
             cx.structural(
                 Hub::cylinder(motion, d, w, l, axis, center, mat.density, c.closed_ends),
@@ -313,14 +482,14 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                     format!("missing field `{k}` (or give hub.shape)"),
                 )
             };
-            let mass = cx.positive(rh.mass.as_ref().ok_or_else(|| missing("mass"))?, "hub.mass")?;
-            let inertia_s = rh.inertia.as_ref().ok_or_else(|| missing("inertia"))?;
-            let inertia = cx.structural(
-                inertia_tensor(inertia_s.get_ref()),
-                inertia_s.span(),
-                "hub.inertia",
+            let mass = cx.bounded(
+                rh.mass.as_ref().ok_or_else(|| missing("mass"))?,
+                "hub.mass",
+                L::MASS,
             )?;
-            let c = cx.vec3(
+            let inertia_s = rh.inertia.as_ref().ok_or_else(|| missing("inertia"))?;
+            let inertia = cx.inertia(inertia_s, "hub.inertia")?;
+            let c = cx.point(
                 rh.center_of_mass
                     .as_ref()
                     .ok_or_else(|| missing("center_of_mass"))?,
@@ -372,7 +541,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 )
             })?;
             Ok(Attachment::Hub {
-                point: cx.vec3(p, format!("{key}.{point_key}"))?,
+                point: cx.point(p, format!("{key}.{point_key}"))?,
             })
         } else {
             if let Some(p) = point {
@@ -390,14 +559,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                     "missing field `station`: distance from the parent beam's root",
                 )
             })?;
-            let st = *s.get_ref();
-            if !(st.is_finite() && st >= 0.0) {
-                return Err(cx.invalid(
-                    s.span(),
-                    format!("{key}.station"),
-                    format!("must be a finite distance >= 0, got {st}"),
-                ));
-            }
+            let st = cx.bounded(s, format!("{key}.station"), L::STATION)?;
             Ok(Attachment::Beam {
                 beam: parent.get_ref().clone(),
                 station: st,
@@ -409,8 +571,9 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     for (i, b) in raw.beams.iter().enumerate() {
         let b = b.get_ref();
         let k = format!("beams[{i}]");
+        cx.name(&b.name, format!("{k}.name"))?;
         let attachment = attach(&k, &b.parent, &b.station, &b.root, "root")?;
-        let length = cx.positive(&b.length, format!("{k}.length"))?;
+        let length = cx.bounded(&b.length, format!("{k}.length"), L::LENGTH)?;
         let mat = material(&b.material, format!("{k}.material"))?;
         let sec = b.section.get_ref();
         let sk = format!("{k}.section");
@@ -434,8 +597,12 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                     ));
                 }
                 let t = t.get_ref();
-                let d = cx.positive(&t.outer_diameter, format!("{sk}.tube.outer_diameter"))?;
-                let w = cx.positive(&t.wall, format!("{sk}.tube.wall"))?;
+                let d = cx.bounded(
+                    &t.outer_diameter,
+                    format!("{sk}.tube.outer_diameter"),
+                    L::SECTION,
+                )?;
+                let w = cx.bounded(&t.wall, format!("{sk}.tube.wall"), L::SECTION)?;
                 if w >= d / 2.0 {
                     return Err(cx.invalid(
                         t.wall.span(),
@@ -446,9 +613,9 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 cx.structural(BeamSection::tube(d, w), b.section.span(), sk.clone())?
             }
             None => {
-                let need = |v: &Option<S<f64>>, f: &str| -> Result<f64, ScenarioError> {
+                let need = |v: &Option<S<f64>>, f: &str, lim: Limit| -> Result<f64, ScenarioError> {
                     match v {
-                        Some(v) => cx.positive(v, format!("{sk}.{f}")),
+                        Some(v) => cx.bounded(v, format!("{sk}.{f}"), lim),
                         None => Err(cx.err(
                             ErrorKind::Schema,
                             b.section.span(),
@@ -459,11 +626,11 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                         )),
                     }
                 };
-                let area = need(&sec.area, "area")?;
-                let iy = need(&sec.iy, "iy")?;
-                let iz = need(&sec.iz, "iz")?;
-                let j = need(&sec.torsion_constant, "torsion_constant")?;
-                let ip = need(&sec.polar_inertia, "polar_inertia")?;
+                let area = need(&sec.area, "area", L::AREA)?;
+                let iy = need(&sec.iy, "iy", L::SECOND_MOMENT)?;
+                let iz = need(&sec.iz, "iz", L::SECOND_MOMENT)?;
+                let j = need(&sec.torsion_constant, "torsion_constant", L::SECOND_MOMENT)?;
+                let ip = need(&sec.polar_inertia, "polar_inertia", L::SECOND_MOMENT)?;
                 cx.structural(
                     BeamSection::general(area, iy, iz, j, ip),
                     b.section.span(),
@@ -471,9 +638,9 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 )?
             }
         };
-        let axis = cx.vec3(&b.axis, format!("{k}.axis"))?;
+        let axis = cx.direction(&b.axis, format!("{k}.axis"))?;
         let y_axis = match &sec.y_axis {
-            Some(y) => Some(cx.vec3(y, format!("{sk}.y_axis"))?),
+            Some(y) => Some(cx.direction(y, format!("{sk}.y_axis"))?),
             None => None,
         };
         let frame = match Frame::new(axis, y_axis) {
@@ -523,11 +690,12 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     for (i, p) in raw.plates.iter().enumerate() {
         let p = p.get_ref();
         let k = format!("plates[{i}]");
+        cx.name(&p.name, format!("{k}.name"))?;
         let attachment = attach(&k, &p.parent, &p.station, &p.root, "root")?;
-        let length = cx.positive(&p.length, format!("{k}.length"))?;
-        let width = cx.positive(&p.width, format!("{k}.width"))?;
-        let la = cx.vec3(&p.length_axis, format!("{k}.length_axis"))?;
-        let nn = cx.vec3(&p.normal, format!("{k}.normal"))?;
+        let length = cx.bounded(&p.length, format!("{k}.length"), L::LENGTH)?;
+        let width = cx.bounded(&p.width, format!("{k}.width"), L::LENGTH)?;
+        let la = cx.direction(&p.length_axis, format!("{k}.length_axis"))?;
+        let nn = cx.direction(&p.normal, format!("{k}.normal"))?;
         let (d, mu, nu) = match (&p.material, &p.thickness) {
             (Some(m), Some(h)) => {
                 for (v, f) in [
@@ -539,7 +707,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                         return Err(cx.invalid(v.span(), format!("{k}.{f}"), "give either thickness + material or areal_density + bending_stiffness + poisson_ratio"));
                     }
                 }
-                let h = cx.positive(h, format!("{k}.thickness"))?;
+                let h = cx.bounded(h, format!("{k}.thickness"), L::SECTION)?;
                 let mat = material(m, format!("{k}.material"))?;
                 let (d, mu) = Plate::homogeneous_properties(
                     h,
@@ -566,11 +734,12 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                         )
                     })
                 }
-                let mu = cx.positive(
+                let mu = cx.bounded(
                     need(cx, &p.areal_density, p.name.span(), &k, "areal_density")?,
                     format!("{k}.areal_density"),
+                    L::AREAL_DENSITY,
                 )?;
-                let d = cx.positive(
+                let d = cx.bounded(
                     need(
                         cx,
                         &p.bending_stiffness,
@@ -579,16 +748,10 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                         "bending_stiffness",
                     )?,
                     format!("{k}.bending_stiffness"),
+                    L::BENDING_STIFFNESS,
                 )?;
                 let nu_s = need(cx, &p.poisson_ratio, p.name.span(), &k, "poisson_ratio")?;
-                let nu = *nu_s.get_ref();
-                if !(nu.is_finite() && nu > -1.0 && nu < 0.5) {
-                    return Err(cx.invalid(
-                        nu_s.span(),
-                        format!("{k}.poisson_ratio"),
-                        format!("must lie in (-1, 0.5), got {nu}"),
-                    ));
-                }
+                let nu = cx.poisson(nu_s, format!("{k}.poisson_ratio"))?;
                 (d, mu, nu)
             }
             (Some(m), None) => {
@@ -633,10 +796,36 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             terms,
         )
         .map_err(|e| {
-            let (span, f) = match e {
+            // The key the failing field was written as: D and ρh come from the thickness
+            // (and the material) when those are given.
+            let homogeneous = p.thickness.as_ref();
+            let given = |v: &Option<S<f64>>, f: &'static str| {
+                homogeneous
+                    .map(|h| (h.span(), "thickness"))
+                    .or_else(|| v.as_ref().map(|v| (v.span(), f)))
+                    .unwrap_or((p.name.span(), f))
+            };
+            let (span, f) = match &e {
                 StructureError::ZeroAxis {
                     field: "length_axis",
                 } => (p.length_axis.span(), "length_axis"),
+                StructureError::NotPositive { field: "length", .. } => {
+                    (p.length.span(), "length")
+                }
+                StructureError::NotPositive { field: "width", .. } => (p.width.span(), "width"),
+                StructureError::NotPositive {
+                    field: "areal_density",
+                    ..
+                } => given(&p.areal_density, "areal_density"),
+                StructureError::NotPositive {
+                    field: "bending_stiffness",
+                    ..
+                } => given(&p.bending_stiffness, "bending_stiffness"),
+                StructureError::PoissonRatio { .. } => match (&p.material, &p.poisson_ratio) {
+                    (Some(m), _) => (m.span(), "material"),
+                    (None, Some(v)) => (v.span(), "poisson_ratio"),
+                    (None, None) => (p.name.span(), "poisson_ratio"),
+                },
                 _ => (p.normal.span(), "normal"),
             };
             cx.invalid(span, format!("{k}.{f}"), e.to_string())
@@ -652,18 +841,15 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     for (i, m) in raw.masses.iter().enumerate() {
         let m = m.get_ref();
         let k = format!("masses[{i}]");
+        cx.name(&m.name, format!("{k}.name"))?;
         let attachment = attach(&k, &m.parent, &m.station, &m.point, "point")?;
-        let mass = cx.positive(&m.mass, format!("{k}.mass"))?;
+        let mass = cx.bounded(&m.mass, format!("{k}.mass"), L::MASS)?;
         let offset = match &m.offset {
-            Some(o) => cx.vec3(o, format!("{k}.offset"))?,
+            Some(o) => cx.point(o, format!("{k}.offset"))?,
             None => Vec3::ZERO,
         };
         let inertia = match &m.inertia {
-            Some(j) => cx.structural(
-                inertia_tensor(j.get_ref()),
-                j.span(),
-                format!("{k}.inertia"),
-            )?,
+            Some(j) => cx.inertia(j, format!("{k}.inertia"))?,
             None => crate::math::Mat3::ZERO,
         };
         spans.insert(
@@ -716,11 +902,46 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(r) => response(cx, r)?,
         None => ResponseSettings::default(),
     };
+    let mut at = BTreeMap::new();
+    let loc = |span: Range<usize>| Location::of_offset(cx.src, span.start);
+    at.insert(ComponentId::Hub, ("hub".to_string(), loc(raw.hub.span())));
+    for (i, b) in raw.beams.iter().enumerate() {
+        at.insert(
+            ComponentId::Beam(i),
+            (format!("beams[{i}]"), loc(b.get_ref().name.span())),
+        );
+    }
+    for (i, p) in raw.plates.iter().enumerate() {
+        at.insert(
+            ComponentId::Plate(i),
+            (format!("plates[{i}]"), loc(p.get_ref().name.span())),
+        );
+    }
+    for (i, m) in raw.masses.iter().enumerate() {
+        at.insert(
+            ComponentId::Mass(i),
+            (format!("masses[{i}]"), loc(m.get_ref().name.span())),
+        );
+    }
+    let mut keys = BTreeMap::new();
+    if let Some(r) = &raw.response {
+        let span = r.get_ref().output_rate.as_ref().map_or(r.span(), |v| v.span());
+        keys.insert("response.output_rate", loc(span));
+    }
+    if let Some(d) = &raw.deployment {
+        let span = d.get_ref().output_rate.as_ref().map_or(d.span(), |v| v.span());
+        keys.insert("deployment.output_rate", loc(span));
+    }
     Ok(Scenario {
         name,
         structure,
         deployment,
         response,
+        sources: Sources {
+            file: cx.file.to_string(),
+            at,
+            keys,
+        },
     })
 }
 
@@ -731,11 +952,11 @@ fn response(cx: &Ctx, r: &S<RawResponse>) -> Result<ResponseSettings, ScenarioEr
     let d = ResponseSettings::default();
     let rr = r.get_ref();
     let duration = match &rr.duration {
-        Some(v) => cx.positive(v, "response.duration")?,
+        Some(v) => cx.bounded(v, "response.duration", L::DURATION)?,
         None => d.duration,
     };
     let output_rate = match &rr.output_rate {
-        Some(v) => cx.positive(v, "response.output_rate")?,
+        Some(v) => cx.bounded(v, "response.output_rate", L::OUTPUT_RATE)?,
         None => d.output_rate,
     };
     let rows = crate::response::rows(duration, output_rate);
@@ -769,20 +990,12 @@ fn response(cx: &Ctx, r: &S<RawResponse>) -> Result<ResponseSettings, ScenarioEr
             Some(k as usize)
         }
     };
-    let damping_ratio = non_negative(
-        cx,
+    let damping_ratio = cx.bounded_or(
         &rr.damping_ratio,
         d.damping_ratio,
-        "response.damping_ratio".into(),
+        "response.damping_ratio",
+        L::DAMPING_RATIO,
     )?;
-    if damping_ratio >= 1.0 {
-        let span = rr.damping_ratio.as_ref().map_or(r.span(), |v| v.span());
-        return Err(cx.invalid(
-            span,
-            "response.damping_ratio",
-            format!("must be below 1 (an underdamped structure), got {damping_ratio}"),
-        ));
-    }
     Ok(ResponseSettings {
         duration,
         output_rate,
@@ -801,41 +1014,6 @@ pub const DEFAULT_END_TIME: f64 = 300.0;
 pub const DEFAULT_OUTPUT_RATE: f64 = 10.0;
 /// Default relative integration tolerance.
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
-
-fn non_negative(
-    cx: &Ctx,
-    v: &Option<S<f64>>,
-    default: f64,
-    key: String,
-) -> Result<f64, ScenarioError> {
-    match v {
-        None => Ok(default),
-        Some(x) => {
-            let val = *x.get_ref();
-            if val.is_finite() && val >= 0.0 {
-                Ok(val)
-            } else {
-                Err(cx.invalid(
-                    x.span(),
-                    key,
-                    format!("must be a non-negative finite number, got {val}"),
-                ))
-            }
-        }
-    }
-}
-
-fn finite(cx: &Ctx, v: &Option<S<f64>>, default: f64, key: String) -> Result<f64, ScenarioError> {
-    match v {
-        None => Ok(default),
-        Some(x) if x.get_ref().is_finite() => Ok(*x.get_ref()),
-        Some(x) => Err(cx.invalid(
-            x.span(),
-            key,
-            format!("must be finite, got {}", x.get_ref()),
-        )),
-    }
-}
 
 /// Builds the deployment chain from `[deployment]` and the structure (MODEL.md §3.2).
 fn deployment(
@@ -876,29 +1054,45 @@ fn deployment(
         }
         (Some(n), None) => {
             let v = *n.get_ref();
-            if !(1..=1000).contains(&v) {
+            if !(1..=L::MAX_PANELS as i64).contains(&v) {
                 return Err(cx.invalid(
                     n.span(),
                     "deployment.panels",
-                    format!("must be between 1 and 1000, got {v}"),
+                    format!("must be between 1 and {}, got {v}", L::MAX_PANELS),
                 ));
             }
             vec![plate.length / v as f64; v as usize]
         }
         (None, Some(l)) => {
             let v = l.get_ref();
-            if v.is_empty() || v.len() > 1000 {
+            if v.is_empty() || v.len() > L::MAX_PANELS {
                 return Err(cx.invalid(
                     l.span(),
                     "deployment.panel_lengths",
-                    format!("needs 1 to 1000 lengths, got {}", v.len()),
+                    format!("needs 1 to {} lengths, got {}", L::MAX_PANELS, v.len()),
                 ));
             }
-            if let Some(bad) = v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+            if let Some(bad) = v.iter().find(|x| !L::PANEL_LENGTH.contains(**x)) {
                 return Err(cx.invalid(
                     l.span(),
                     "deployment.panel_lengths",
-                    format!("every length must be positive and finite, got {bad}"),
+                    format!(
+                        "every length must lie in {}, got {bad:e}",
+                        L::PANEL_LENGTH.describe()
+                    ),
+                ));
+            }
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), x| (a.min(*x), b.max(*x)));
+            if hi > L::MAX_PANEL_LENGTH_RATIO * lo {
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!(
+                        "the longest panel ({hi} m) is more than {} times the shortest ({lo} m)",
+                        L::MAX_PANEL_LENGTH_RATIO
+                    ),
                 ));
             }
             let sum: f64 = v.iter().sum();
@@ -924,11 +1118,11 @@ fn deployment(
     };
     let n = lengths.len();
     let panel_mass = match &d.panel_mass {
-        Some(m) => Some(cx.positive(m, "deployment.panel_mass")?),
+        Some(m) => Some(cx.bounded(m, "deployment.panel_mass", L::MASS)?),
         None => None,
     };
     let panel_inertia = match &d.panel_inertia {
-        Some(m) => Some(cx.positive(m, "deployment.panel_inertia")?),
+        Some(m) => Some(cx.bounded(m, "deployment.panel_inertia", L::PANEL_INERTIA)?),
         None => None,
     };
     let panels: Vec<Panel> = lengths
@@ -945,31 +1139,26 @@ fn deployment(
     // Hinges: [deployment.hinge] for all, [[deployment.hinges]] per hinge overriding it.
     let all = d.hinge.as_ref().map(|h| h.get_ref());
     let k_all = match all.and_then(|h| h.stiffness.as_ref()) {
-        Some(k) => Some(non_negative(
-            cx,
-            &Some(k.clone()),
-            0.0,
-            "deployment.hinge.stiffness".into(),
-        )?),
+        Some(k) => Some(cx.bounded(k, "deployment.hinge.stiffness", L::HINGE_STIFFNESS)?),
         None => None,
     };
-    let preload = finite(
-        cx,
+    let preload = cx.bounded_or(
         &all.and_then(|h| h.preload_angle.clone()),
         0.0,
-        "deployment.hinge.preload_angle".into(),
+        "deployment.hinge.preload_angle",
+        L::ANGLE,
     )?;
-    let damping_all = non_negative(
-        cx,
+    let damping_all = cx.bounded_or(
         &all.and_then(|h| h.damping.clone()),
         0.0,
-        "deployment.hinge.damping".into(),
+        "deployment.hinge.damping",
+        L::HINGE_DAMPING,
     )?;
-    let friction_all = non_negative(
-        cx,
+    let friction_all = cx.bounded_or(
         &all.and_then(|h| h.friction.clone()),
         0.0,
-        "deployment.hinge.friction".into(),
+        "deployment.hinge.friction",
+        L::HINGE_FRICTION,
     )?;
     if let Some(list) = &d.hinges {
         if list.len() != n {
@@ -993,11 +1182,11 @@ fn deployment(
             }
         };
         let default_latch = if i == 0 { PI / 2.0 } else { PI };
-        let latch = finite(
-            cx,
+        let latch = cx.bounded_or(
             &r.and_then(|h| h.latch_angle.clone()),
             default_latch,
             key("latch_angle"),
+            L::ANGLE,
         )?;
         if !(latch > 0.0 && latch <= PI) {
             let span = r
@@ -1010,7 +1199,7 @@ fn deployment(
             ));
         }
         let stiffness = match r.and_then(|h| h.stiffness.clone()) {
-            Some(k) => non_negative(cx, &Some(k), 0.0, key("stiffness"))?,
+            Some(k) => cx.bounded(&k, key("stiffness"), L::HINGE_STIFFNESS)?,
             None => k_all.ok_or_else(|| {
                 cx.invalid(
                     one.map_or(raw.span(), |h| h.span()),
@@ -1019,17 +1208,17 @@ fn deployment(
                 )
             })?,
         };
-        let reference = finite(
-            cx,
+        let reference = cx.bounded_or(
             &r.and_then(|h| h.reference_angle.clone()),
             latch + preload,
             key("reference_angle"),
+            L::ANGLE,
         )?;
-        let initial = finite(
-            cx,
+        let initial = cx.bounded_or(
             &r.and_then(|h| h.initial_angle.clone()),
             0.0,
             key("initial_angle"),
+            L::ANGLE,
         )?;
         if initial >= latch {
             let span = r
@@ -1044,25 +1233,25 @@ fn deployment(
         hinges.push(Hinge {
             stiffness,
             reference_angle: reference,
-            damping: non_negative(
-                cx,
+            damping: cx.bounded_or(
                 &r.and_then(|h| h.damping.clone()),
                 damping_all,
                 key("damping"),
+                L::HINGE_DAMPING,
             )?,
-            friction: non_negative(
-                cx,
+            friction: cx.bounded_or(
                 &r.and_then(|h| h.friction.clone()),
                 friction_all,
                 key("friction"),
+                L::HINGE_FRICTION,
             )?,
             latch_angle: latch,
             initial_angle: initial,
-            initial_rate: finite(
-                cx,
+            initial_rate: cx.bounded_or(
                 &r.and_then(|h| h.initial_rate.clone()),
                 0.0,
                 key("initial_rate"),
+                L::RATE,
             )?,
         });
     }
@@ -1083,19 +1272,34 @@ fn deployment(
         hub,
         root: [arm.dot(plate.length_axis), arm.dot(plate.normal)],
     };
-    let pos = |v: &Option<S<f64>>, default: f64, key: &str| -> Result<f64, ScenarioError> {
-        match v {
-            Some(x) => cx.positive(x, key),
-            None => Ok(default),
-        }
-    };
-    let tolerance = pos(&d.tolerance, DEFAULT_TOLERANCE, "deployment.tolerance")?;
-    if tolerance > 1e-3 {
-        let span = d.tolerance.as_ref().map_or(raw.span(), |x| x.span());
+    let tolerance = cx.bounded_or(
+        &d.tolerance,
+        DEFAULT_TOLERANCE,
+        "deployment.tolerance",
+        L::TOLERANCE,
+    )?;
+    let end_time = cx.bounded_or(&d.end_time, DEFAULT_END_TIME, "deployment.end_time", L::DURATION)?;
+    let output_rate = cx.bounded_or(
+        &d.output_rate,
+        DEFAULT_OUTPUT_RATE,
+        "deployment.output_rate",
+        L::OUTPUT_RATE,
+    )?;
+    let rows = crate::response::rows(end_time, output_rate);
+    if rows > crate::response::MAX_ROWS {
+        let span = d
+            .output_rate
+            .as_ref()
+            .or(d.end_time.as_ref())
+            .map_or(raw.span(), |v| v.span());
         return Err(cx.invalid(
             span,
-            "deployment.tolerance",
-            format!("must be at most 1e-3, got {tolerance}"),
+            "deployment.output_rate",
+            format!(
+                "{end_time} s at {output_rate} Hz would write {rows} rows; the limit is {} \
+                 (lower output_rate or end_time)",
+                crate::response::MAX_ROWS
+            ),
         ));
     }
     Ok(Deployment {
@@ -1105,12 +1309,8 @@ fn deployment(
             Some(RawLatching::Simultaneous) => Latching::Simultaneous,
             _ => Latching::Sequential,
         },
-        end_time: pos(&d.end_time, DEFAULT_END_TIME, "deployment.end_time")?,
-        output_rate: pos(
-            &d.output_rate,
-            DEFAULT_OUTPUT_RATE,
-            "deployment.output_rate",
-        )?,
+        end_time,
+        output_rate,
         tolerance,
     })
 }

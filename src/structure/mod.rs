@@ -142,11 +142,11 @@ pub(crate) fn finite_vec(field: &'static str, v: Vec3) -> Result<Vec3, Structure
 
 pub(crate) fn unit(field: &'static str, v: Vec3) -> Result<Vec3, StructureError> {
     finite_vec(field, v)?;
-    let n = v.norm();
-    if n < 1e-12 {
+    // A direction of any scale is accepted; only the zero vector has none.
+    if v.0.iter().all(|x| *x == 0.0) {
         return Err(StructureError::ZeroAxis { field });
     }
-    Ok(v * (1.0 / n))
+    Ok(v.normalized())
 }
 
 /// Reference to a component of the structure.

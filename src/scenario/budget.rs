@@ -1,0 +1,155 @@
+//! What a run will cost before it starts: memory and output size estimated from the
+//! scenario alone, so that a run that would exhaust the machine is refused with a location
+//! instead of dying in an allocation half-way (docs/scenario.md, "Limits").
+//!
+//! The model (measured on the seed structure with plate terms 20×20 … 40×40, peak resident
+//! memory of `flexcraft modes` ≈ 18–20 · 8n² bytes for n generalized coordinates): the
+//! assembly and the generalized eigen-solve hold about [`MATRICES_PER_SOLVE`] dense n × n
+//! matrices at once. Time series cost 8 bytes per number in memory plus about
+//! [`CSV_BYTES_PER_NUMBER`] bytes of CSV text.
+
+use super::{Scenario, ScenarioError};
+use crate::structure::ComponentId;
+
+/// Dense n × n matrices alive at the peak of a modal solve (assembly, scaling, the Cholesky
+/// factor, the reduced problem, its eigenvectors, the back-transformed modes and the
+/// Rayleigh-quotient products), rounded up.
+pub const MATRICES_PER_SOLVE: u64 = 20;
+/// Bytes of CSV text per number written (`1.2345678901234567e-5,`), rounded up.
+pub const CSV_BYTES_PER_NUMBER: u64 = 24;
+/// Memory of the program itself, bytes.
+pub const BASELINE_BYTES: u64 = 32 << 20;
+
+/// The estimated cost of a run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Estimate {
+    /// Generalized coordinates of the Ritz model.
+    pub dof: u64,
+    /// Peak memory of the modal solve, bytes.
+    pub modes_bytes: u64,
+    /// Deployment samples × numbers per sample.
+    pub deployment_cells: u64,
+    /// Response samples × numbers per sample.
+    pub response_cells: u64,
+}
+
+impl Estimate {
+    /// Peak memory of the whole run, bytes: the modal solve, then every time series held
+    /// in memory together with its CSV text.
+    pub fn peak_bytes(&self) -> u64 {
+        let series = (self.deployment_cells + self.response_cells)
+            .saturating_mul(8 + CSV_BYTES_PER_NUMBER);
+        BASELINE_BYTES
+            .saturating_add(self.modes_bytes)
+            .saturating_add(series)
+    }
+}
+
+/// Human-readable bytes ("1.5 GiB").
+pub fn format_bytes(b: u64) -> String {
+    const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+    let mut v = b as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
+}
+
+impl Scenario {
+    /// The cost of `simulate` on this scenario (an upper bound for `modes` and `deploy`).
+    pub fn estimate(&self) -> Estimate {
+        let st = &self.structure;
+        let dof = 6
+            + st.beams.iter().map(|b| b.terms.dof() as u64).sum::<u64>()
+            + st.plates.iter().map(|p| p.terms.dof() as u64).sum::<u64>();
+        let modes_bytes = MATRICES_PER_SOLVE.saturating_mul(8 * dof * dof);
+        let deployment_cells = self.deployment.as_ref().map_or(0, |d| {
+            let n = d.chain.len() as u64;
+            // t, α, α̇, hub (3 + 3), reactions (2N), moments (N), energies, hinge points
+            // (2(N + 1)): one sample, plus a copy at every latch.
+            let per_sample = 10 + 8 * n;
+            crate::response::rows(d.end_time, d.output_rate)
+                .saturating_add(2 * n)
+                .saturating_mul(per_sample)
+        });
+        let response_cells = if self.deployment.is_some() {
+            let channels = 6 + 3 * st.beams.len() as u64 + 2 * st.plates.len() as u64;
+            let modes = self.response.modes.map_or(dof, |m| (m as u64).min(dof));
+            self.response
+                .rows()
+                .saturating_mul(1 + channels + modes)
+        } else {
+            0
+        };
+        Estimate {
+            dof,
+            modes_bytes,
+            deployment_cells,
+            response_cells,
+        }
+    }
+
+    /// Refuses a run whose estimated peak memory exceeds `max_bytes`, located at the key
+    /// that drives it: the component with the most Ritz terms, or the output rate of the
+    /// longest time series.
+    pub fn check_budget(&self, max_bytes: u64) -> Result<Estimate, ScenarioError> {
+        let e = self.estimate();
+        let peak = e.peak_bytes();
+        if peak <= max_bytes {
+            return Ok(e);
+        }
+        let why = format!(
+            "the run would need about {} of memory (limit {}; raise it with --max-memory)",
+            format_bytes(peak),
+            format_bytes(max_bytes)
+        );
+        let st = &self.structure;
+        if e.modes_bytes >= e.peak_bytes() / 2 {
+            let biggest = st
+                .beams
+                .iter()
+                .enumerate()
+                .map(|(i, b)| (b.terms.dof(), ComponentId::Beam(i)))
+                .chain(
+                    st.plates
+                        .iter()
+                        .enumerate()
+                        .map(|(i, p)| (p.terms.dof(), ComponentId::Plate(i))),
+                )
+                .max_by_key(|(n, _)| *n);
+            let (n, id) = biggest.unwrap_or((0, ComponentId::Hub));
+            let mut err = self.locate(
+                id,
+                format!(
+                    "{n} of the model's {} generalized coordinates are this component's terms: {why}",
+                    e.dof
+                ),
+            );
+            err.key.push_str(".terms");
+            return Err(err);
+        }
+        let key = if e.response_cells >= e.deployment_cells {
+            "response.output_rate"
+        } else {
+            "deployment.output_rate"
+        };
+        Err(self.locate_key(key, format!("the time series are too long: {why}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bytes_read_well() {
+        assert_eq!(format_bytes(512), "512 B");
+        assert_eq!(format_bytes(3 << 29), "1.5 GiB");
+    }
+}
