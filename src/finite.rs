@@ -40,7 +40,10 @@ pub fn check_modes(m: &ModalAnalysis) -> Result<(), NonFinite> {
             format!("mode {k} shape coefficient {}", i + 1)
         })?;
         check(mode.strain_energy_share.iter().map(|s| s.1), |i| {
-            format!("mode {k} strain-energy share of {}", mode.strain_energy_share[i].0)
+            format!(
+                "mode {k} strain-energy share of {}",
+                mode.strain_energy_share[i].0
+            )
         })?;
         check(mode.effective_mass.into_iter().flatten(), |i| {
             format!("mode {k} effective mass {}", i + 1)
@@ -74,7 +77,9 @@ pub fn check_deployment(r: &DeploymentResult) -> Result<(), NonFinite> {
             .chain(e.rates_after.iter().copied())
             .chain([e.energy_before, e.energy_after])
             .chain(e.impulses.iter().flat_map(|(p, m)| [p[0], p[1], *m]));
-        check(values, |_| format!("latch of hinge {} at t = {} s", e.hinge, e.time))?;
+        check(values, |_| {
+            format!("latch of hinge {} at t = {} s", e.hinge, e.time)
+        })?;
     }
     Ok(())
 }

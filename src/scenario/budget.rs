@@ -37,8 +37,8 @@ impl Estimate {
     /// Peak memory of the whole run, bytes: the modal solve, then every time series held
     /// in memory together with its CSV text.
     pub fn peak_bytes(&self) -> u64 {
-        let series = (self.deployment_cells + self.response_cells)
-            .saturating_mul(8 + CSV_BYTES_PER_NUMBER);
+        let series =
+            (self.deployment_cells + self.response_cells).saturating_mul(8 + CSV_BYTES_PER_NUMBER);
         BASELINE_BYTES
             .saturating_add(self.modes_bytes)
             .saturating_add(series)
@@ -81,9 +81,7 @@ impl Scenario {
         let response_cells = if self.deployment.is_some() {
             let channels = 6 + 3 * st.beams.len() as u64 + 2 * st.plates.len() as u64;
             let modes = self.response.modes.map_or(dof, |m| (m as u64).min(dof));
-            self.response
-                .rows()
-                .saturating_mul(1 + channels + modes)
+            self.response.rows().saturating_mul(1 + channels + modes)
         } else {
             0
         };

@@ -40,7 +40,13 @@ const fn above(lo: f64, hi: f64, unit: &'static str) -> Limit {
 impl Limit {
     /// Whether `v` is finite and inside the interval.
     pub fn contains(&self, v: f64) -> bool {
-        v.is_finite() && v <= self.hi && if self.open_lo { v > self.lo } else { v >= self.lo }
+        v.is_finite()
+            && v <= self.hi
+            && if self.open_lo {
+                v > self.lo
+            } else {
+                v >= self.lo
+            }
     }
 
     /// "[1e-3, 1e4] m", for messages and docs.
@@ -103,7 +109,11 @@ pub const HINGE_DAMPING: Limit = closed(0.0, 1e6, "N·m·s/rad");
 /// Hinge Coulomb friction moment.
 pub const HINGE_FRICTION: Limit = closed(0.0, 1e5, "N·m");
 /// Hinge angles given by the user (preload, reference, initial), rad.
-pub const ANGLE: Limit = closed(-4.0 * std::f64::consts::PI, 4.0 * std::f64::consts::PI, "rad");
+pub const ANGLE: Limit = closed(
+    -4.0 * std::f64::consts::PI,
+    4.0 * std::f64::consts::PI,
+    "rad",
+);
 /// Initial hinge rate.
 pub const RATE: Limit = closed(-100.0, 100.0, "rad/s");
 /// Panel moment of inertia about its hinge-parallel centroidal axis.
@@ -118,8 +128,9 @@ pub const MAX_PANELS: usize = 100;
 pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
 /// Deployment end time and response duration.
 pub const DURATION: Limit = above(0.0, 1e6, "s");
-/// Modal damping ratio of the response (an underdamped structure: below 1).
-pub const DAMPING_RATIO: Limit = closed(0.0, 0.999, "");
+/// Modal damping ratio of the response, [0, 1): an underdamped structure (1 itself is
+/// refused by the scenario layer).
+pub const DAMPING_RATIO: Limit = closed(0.0, 1.0, "");
 /// Output sample rates.
 pub const OUTPUT_RATE: Limit = above(0.0, 1e5, "Hz");
 
@@ -162,7 +173,9 @@ pub fn valid_name(name: &str) -> Result<(), String> {
 pub fn valid_title(title: &str) -> Result<(), String> {
     let n = title.chars().count();
     if n > MAX_TITLE {
-        return Err(format!("the title has at most {MAX_TITLE} characters, got {n}"));
+        return Err(format!(
+            "the title has at most {MAX_TITLE} characters, got {n}"
+        ));
     }
     if title.chars().any(char::is_control) {
         return Err("the title must not contain control characters".into());

@@ -14,11 +14,11 @@ use crate::deploy::{Deployment, Latching};
 use crate::math::Vec3;
 use crate::response::{HandoverMethod, ResponseSettings};
 use crate::structure::{
-    inertia_tensor, Attachment, ComponentId, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass,
-    Material, Plate, PlateTerms, Structure, StructureError,
+    inertia_tensor, Attachment, Beam, BeamSection, BeamTerms, ComponentId, Frame, Hub, HubMotion,
+    LumpedMass, Material, Plate, PlateTerms, Structure, StructureError,
 };
-use limits::Limit;
 use limits as L;
+use limits::Limit;
 use raw::*;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -133,7 +133,12 @@ impl Ctx<'_> {
     }
 
     /// A scalar inside its accepted range ([`limits`]).
-    fn bounded(&self, v: &S<f64>, key: impl Into<String>, lim: Limit) -> Result<f64, ScenarioError> {
+    fn bounded(
+        &self,
+        v: &S<f64>,
+        key: impl Into<String>,
+        lim: Limit,
+    ) -> Result<f64, ScenarioError> {
         let x = *v.get_ref();
         if lim.contains(x) {
             Ok(x)
@@ -141,7 +146,15 @@ impl Ctx<'_> {
             Err(self.invalid(
                 v.span(),
                 key,
-                format!("must lie in {}, got {x:e}", lim.describe()),
+                format!(
+                    "must be a {}finite number in {}, got {x:e}",
+                    if lim.lo > 0.0 || (lim.open_lo && lim.lo == 0.0) {
+                        "positive "
+                    } else {
+                        ""
+                    },
+                    lim.describe()
+                ),
             ))
         }
     }
@@ -180,8 +193,7 @@ impl Ctx<'_> {
         let vals = v.get_ref();
         for (i, x) in vals.iter().enumerate() {
             let diagonal = i < 3;
-            let ok = L::INERTIA.contains(*x)
-                && (!diagonal || x.abs() >= L::MIN_PRINCIPAL_INERTIA);
+            let ok = L::INERTIA.contains(*x) && (!diagonal || x.abs() >= L::MIN_PRINCIPAL_INERTIA);
             if !ok {
                 return Err(self.invalid(
                     v.span(),
@@ -239,7 +251,8 @@ impl Ctx<'_> {
             Err(self.invalid(
                 v.span(),
                 key,
-                "a direction needs finite components, not all zero",
+                "has zero length or a non-finite component (a direction needs finite \
+                 components, not all zero)",
             ))
         }
     }
@@ -402,7 +415,11 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
             return Err(cx.invalid(m.span(), "materials", format!("material name: {why}")));
         }
         let k = format!("materials.{mname}");
-        let e = cx.bounded(&m.get_ref().youngs_modulus, format!("{k}.youngs_modulus"), L::MODULUS)?;
+        let e = cx.bounded(
+            &m.get_ref().youngs_modulus,
+            format!("{k}.youngs_modulus"),
+            L::MODULUS,
+        )?;
         let rho = cx.bounded(&m.get_ref().density, format!("{k}.density"), L::DENSITY)?;
         let nu = cx.poisson(&m.get_ref().poisson_ratio, format!("{k}.poisson_ratio"))?;
         let g = match &m.get_ref().shear_modulus {
@@ -613,19 +630,20 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 cx.structural(BeamSection::tube(d, w), b.section.span(), sk.clone())?
             }
             None => {
-                let need = |v: &Option<S<f64>>, f: &str, lim: Limit| -> Result<f64, ScenarioError> {
-                    match v {
-                        Some(v) => cx.bounded(v, format!("{sk}.{f}"), lim),
-                        None => Err(cx.err(
-                            ErrorKind::Schema,
-                            b.section.span(),
-                            format!("{sk}.{f}"),
-                            format!(
+                let need =
+                    |v: &Option<S<f64>>, f: &str, lim: Limit| -> Result<f64, ScenarioError> {
+                        match v {
+                            Some(v) => cx.bounded(v, format!("{sk}.{f}"), lim),
+                            None => Err(cx.err(
+                                ErrorKind::Schema,
+                                b.section.span(),
+                                format!("{sk}.{f}"),
+                                format!(
                                 "missing field `{f}` (or give tube = {{ outer_diameter, wall }})"
                             ),
-                        )),
-                    }
-                };
+                            )),
+                        }
+                    };
                 let area = need(&sec.area, "area", L::AREA)?;
                 let iy = need(&sec.iy, "iy", L::SECOND_MOMENT)?;
                 let iz = need(&sec.iz, "iz", L::SECOND_MOMENT)?;
@@ -809,9 +827,9 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
                 StructureError::ZeroAxis {
                     field: "length_axis",
                 } => (p.length_axis.span(), "length_axis"),
-                StructureError::NotPositive { field: "length", .. } => {
-                    (p.length.span(), "length")
-                }
+                StructureError::NotPositive {
+                    field: "length", ..
+                } => (p.length.span(), "length"),
                 StructureError::NotPositive { field: "width", .. } => (p.width.span(), "width"),
                 StructureError::NotPositive {
                     field: "areal_density",
@@ -925,11 +943,19 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
     }
     let mut keys = BTreeMap::new();
     if let Some(r) = &raw.response {
-        let span = r.get_ref().output_rate.as_ref().map_or(r.span(), |v| v.span());
+        let span = r
+            .get_ref()
+            .output_rate
+            .as_ref()
+            .map_or(r.span(), |v| v.span());
         keys.insert("response.output_rate", loc(span));
     }
     if let Some(d) = &raw.deployment {
-        let span = d.get_ref().output_rate.as_ref().map_or(d.span(), |v| v.span());
+        let span = d
+            .get_ref()
+            .output_rate
+            .as_ref()
+            .map_or(d.span(), |v| v.span());
         keys.insert("deployment.output_rate", loc(span));
     }
     Ok(Scenario {
@@ -990,12 +1016,20 @@ fn response(cx: &Ctx, r: &S<RawResponse>) -> Result<ResponseSettings, ScenarioEr
             Some(k as usize)
         }
     };
-    let damping_ratio = cx.bounded_or(
-        &rr.damping_ratio,
-        d.damping_ratio,
-        "response.damping_ratio",
-        L::DAMPING_RATIO,
-    )?;
+    let damping_ratio = match &rr.damping_ratio {
+        None => d.damping_ratio,
+        Some(v) if L::DAMPING_RATIO.contains(*v.get_ref()) && *v.get_ref() < 1.0 => *v.get_ref(),
+        Some(v) => {
+            return Err(cx.invalid(
+                v.span(),
+                "response.damping_ratio",
+                format!(
+                    "must lie in [0, 1): below 1 (an underdamped structure), got {}",
+                    v.get_ref()
+                ),
+            ))
+        }
+    };
     Ok(ResponseSettings {
         duration,
         output_rate,
@@ -1278,7 +1312,12 @@ fn deployment(
         "deployment.tolerance",
         L::TOLERANCE,
     )?;
-    let end_time = cx.bounded_or(&d.end_time, DEFAULT_END_TIME, "deployment.end_time", L::DURATION)?;
+    let end_time = cx.bounded_or(
+        &d.end_time,
+        DEFAULT_END_TIME,
+        "deployment.end_time",
+        L::DURATION,
+    )?;
     let output_rate = cx.bounded_or(
         &d.output_rate,
         DEFAULT_OUTPUT_RATE,

@@ -236,8 +236,8 @@ fn bad_cases() -> Vec<(
         (
             "response rows",
             SEED,
-            "output_rate = 50.0",
-            "output_rate = 5e5",
+            "duration = 60.0\noutput_rate = 50.0",
+            "duration = 6e5\noutput_rate = 50.0",
             "response.output_rate",
             "30000001 rows; the limit is 10000000",
         ),
