@@ -31,6 +31,10 @@ enum Command {
         /// Also write modes.json, frequencies.csv, coefficient and shape CSVs and plots here.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
+        /// marker). DIR is always replaced as a whole, never merged into.
+        #[arg(long, requires = "out")]
+        force: bool,
     },
     /// Deployment of the accordion-folded array in [deployment]: hinge springs, loads,
     /// latching with impact, hub disturbance.
@@ -44,6 +48,10 @@ enum Command {
         /// Also write deployment.csv, events.json and plots here.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
+        /// marker). DIR is always replaced as a whole, never merged into.
+        #[arg(long, requires = "out")]
+        force: bool,
     },
     /// The whole story: modes of the deployed spacecraft, deployment of the array, hand-over
     /// at the final latch and the latch-excited vibration, hub drift and attitude motion.
@@ -58,6 +66,10 @@ enum Command {
         /// deployment.csv, events.json, response.csv and plots here.
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
+        /// marker). DIR is always replaced as a whole, never merged into.
+        #[arg(long, requires = "out")]
+        force: bool,
         /// Open DIR/report.html in the default browser when done (needs --out).
         #[arg(long, requires = "out")]
         open: bool,
@@ -74,26 +86,30 @@ fn main() -> ExitCode {
             scenario,
             json,
             out,
-        } => run_modes(&scenario, json, out.as_deref()),
+            force,
+        } => run_modes(&scenario, json, out.as_deref(), force),
         Command::Deploy {
             scenario,
             json,
             out,
-        } => run_deploy(&scenario, json, out.as_deref()),
+            force,
+        } => run_deploy(&scenario, json, out.as_deref(), force),
         Command::Simulate {
             scenario,
             json,
             out,
+            force,
             open,
             quiet,
-        } => run_simulate(&scenario, json, out.as_deref(), open, quiet),
+        } => run_simulate(&scenario, json, out.as_deref(), force, open, quiet),
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
 }
 
-/// Exit statuses: 2 the input was refused (the scenario, or a missing section the command
-/// needs); 1 a numerical failure or an output that could not be written; 0 otherwise — an
-/// array that does not latch is a result, not an error.
+/// Exit statuses: 2 the input was refused (the scenario, a missing section the command
+/// needs, or an --out folder that must not be replaced); 1 a numerical failure or an output
+/// that could not be written (stdout included); 0 otherwise — an array that does not latch is
+/// a result, not an error.
 const REFUSED: u8 = 2;
 const FAILED: u8 = 1;
 
@@ -145,27 +161,39 @@ fn numerical_failure(
     ExitCode::from(FAILED)
 }
 
-/// Prints the JSON object or the table, then writes the output directory (staged, renamed
-/// when complete) with `write`.
+/// Checks, locks and stages the output directory before the computation: a target that must
+/// not be replaced is refused (exit status 2) before any work is done.
+fn prepare(out: Option<&Path>, force: bool) -> Result<Option<OutputDir>, ExitCode> {
+    let Some(dir) = out else { return Ok(None) };
+    OutputDir::create(dir, force).map(Some).map_err(|e| {
+        if e.is_refusal() {
+            eprintln!("error: {e}");
+            ExitCode::from(REFUSED)
+        } else {
+            eprintln!("error: writing {}: {e}", dir.display());
+            ExitCode::from(FAILED)
+        }
+    })
+}
+
+/// Prints the JSON object or the table, then writes the prepared output directory with
+/// `write` and swaps it in whole.
 fn finish(
     json: bool,
     json_text: impl FnOnce() -> String,
     table: impl FnOnce() -> String,
-    out: Option<&Path>,
+    out: Option<(OutputDir, &Path)>,
     write: impl FnOnce(&mut OutputDir) -> Result<(), output::OutputError>,
 ) -> Result<(), ExitCode> {
     if json {
-        emit(&(json_text() + "\n"));
+        emit(&(json_text() + "\n"))?;
     } else {
-        emit(&table());
+        emit(&table())?;
     }
-    if let Some(dir) = out {
-        let written = OutputDir::create(dir).and_then(|mut o| {
-            write(&mut o)?;
-            o.commit()
-        });
+    if let Some((mut o, dir)) = out {
+        let written = write(&mut o).and_then(|()| o.commit());
         match written {
-            Ok(files) if !json => emit(&format!("wrote {} files to {}\n", files, dir.display())),
+            Ok(files) if !json => emit(&format!("wrote {} files to {}\n", files, dir.display()))?,
             Ok(_) => {}
             Err(e) => {
                 eprintln!("error: writing {}: {e}", dir.display());
@@ -176,8 +204,9 @@ fn finish(
     Ok(())
 }
 
-fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+fn run_modes(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Result<(), ExitCode> {
     let scenario = load(path)?;
+    let staged = prepare(out, force)?;
     let model = RitzModel::assemble(&scenario.structure);
     let modes =
         ModalAnalysis::compute(&model).map_err(|e| numerical_failure(&scenario, &model, &e))?;
@@ -186,21 +215,22 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode
         json,
         || output::modes_json(&model, &modes),
         || output::modes_table(&scenario, &model, &modes),
-        out,
+        staged.zip(out),
         |d| output::write_modes(d, &model, &modes),
     )
 }
 
-fn run_deploy(path: &Path, json: bool, out: Option<&Path>) -> Result<(), ExitCode> {
+fn run_deploy(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Result<(), ExitCode> {
     let scenario = load(path)?;
     let d = need_deployment(path, &scenario)?;
+    let staged = prepare(out, force)?;
     let result = flexcraft::deploy::simulate(d);
     not_finite(path, flexcraft::finite::check_deployment(&result))?;
     finish(
         json,
         || output::deploy_json(&scenario.name, d, &result),
         || output::deploy_table(&scenario.name, d, &result),
-        out,
+        staged.zip(out),
         |o| output::write_deploy(o, &scenario.name, d, &result),
     )
 }
@@ -209,6 +239,7 @@ fn run_simulate(
     path: &Path,
     json: bool,
     out: Option<&Path>,
+    force: bool,
     open: bool,
     quiet: bool,
 ) -> Result<(), ExitCode> {
@@ -217,6 +248,7 @@ fn run_simulate(
     let progress = Progress::new(quiet);
     let scenario = load(path)?;
     need_deployment(path, &scenario)?;
+    let staged = prepare(out, force)?;
     let source = std::fs::read(path).unwrap_or_default();
     progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| match &e {
@@ -237,7 +269,7 @@ fn run_simulate(
         json,
         || output::simulate_json(&scenario, &sim),
         || output::simulate_table(&scenario, &sim),
-        out,
+        staged.zip(out),
         |o| output::write_simulate(o, &scenario, &sim, &source, &file_name),
     )?;
     progress.done();
@@ -318,9 +350,16 @@ fn open_in_browser(file: &Path) {
     }
 }
 
-/// Prints to stdout; a closed pipe (`flexcraft modes … | head`) is not an error.
-fn emit(text: &str) {
+/// Prints to stdout; a closed pipe (`flexcraft modes … | head`) is not an error, any other
+/// write error is (exit status 1: `flexcraft simulate --json > /dev/full`).
+fn emit(text: &str) -> Result<(), ExitCode> {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
-    let _ = out.write_all(text.as_bytes()).and_then(|()| out.flush());
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("error: writing to stdout: {e}");
+            Err(ExitCode::from(FAILED))
+        }
+        _ => Ok(()),
+    }
 }

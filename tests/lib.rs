@@ -13,6 +13,7 @@ mod suite {
     pub mod exact_beams;
     pub mod modal_properties;
     pub mod mutations;
+    pub mod output_dir;
     pub mod plates;
     pub mod report;
     pub mod response;

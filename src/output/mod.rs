@@ -9,7 +9,7 @@ pub mod plot;
 mod report;
 mod simulate;
 
-pub use atomic::OutputDir;
+pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
 pub use report::report_html;
@@ -36,6 +36,41 @@ pub enum OutputError {
         /// What went wrong.
         reason: String,
     },
+    /// An existing, non-empty output folder that flexcraft did not write (no marker file):
+    /// replacing it needs `--force`.
+    #[error(
+        "{}: exists and was not written by flexcraft (no {MARKER} marker); choose another --out or pass --force to replace it",
+        dir.display()
+    )]
+    NotOurs {
+        /// The folder, as named by the user.
+        dir: std::path::PathBuf,
+    },
+    /// A target that is never replaced: `/`, the home folder, the current folder, a mount
+    /// point, a file.
+    #[error("{}: {reason}; choose another --out", dir.display())]
+    ForbiddenTarget {
+        /// The folder, as named by the user.
+        dir: std::path::PathBuf,
+        /// Why it is refused.
+        reason: String,
+    },
+    /// A file name that would leave the output folder (absolute, `..`, NUL, …).
+    #[error("unsafe output file name \"{name}\": {reason}")]
+    UnsafePath {
+        /// The name, escaped.
+        name: String,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+}
+
+impl OutputError {
+    /// True for a refusal of the target the user named (exit status 2), false for a failure
+    /// while writing (exit status 1).
+    pub fn is_refusal(&self) -> bool {
+        matches!(self, Self::NotOurs { .. } | Self::ForbiddenTarget { .. })
+    }
 }
 
 impl From<OutputError> for std::io::Error {
