@@ -9,6 +9,59 @@ use crate::simulation::Response;
 /// One curve: name, x and y samples.
 pub type Curve = (String, Vec<f64>, Vec<f64>);
 
+/// Most points drawn per curve (PNG, SVG and the report); longer series are decimated by
+/// [`decimate`]. Above every example's series length (≤ 3 001 samples), so their pictures
+/// and reports are drawn from every sample. The CSV files always keep every row.
+pub const PLOT_POINTS: usize = 4000;
+
+/// Indices of the samples `0..n` to draw when at most `max_points` (≥ 4) may be: all of them
+/// when `n ≤ max_points`; otherwise the first and the last, and of each of
+/// `(max_points − 2) / 2` equal runs of the samples in between, those of its minimum and its
+/// maximum of `y` (the first of equal ones; NaN is never picked unless a run holds nothing
+/// else), in increasing order. Every extremum of the series survives exactly, the order of
+/// the samples (monotone x) is kept, and the result has at most `max_points` indices.
+pub fn decimate(n: usize, y: impl Fn(usize) -> f64, max_points: usize) -> Vec<usize> {
+    let max_points = max_points.max(4);
+    if n <= max_points {
+        return (0..n).collect();
+    }
+    let inner = n - 2; // samples 1..=n-2
+    let buckets = (max_points - 2) / 2;
+    let mut out = Vec::with_capacity(2 * buckets + 2);
+    out.push(0);
+    for b in 0..buckets {
+        // Run b: samples 1 + [b·inner/buckets, (b+1)·inner/buckets), never empty.
+        let lo = 1 + b * inner / buckets;
+        let hi = 1 + (b + 1) * inner / buckets;
+        let (mut imin, mut imax) = (lo, lo);
+        let (mut vmin, mut vmax) = (y(lo), y(lo));
+        for k in lo + 1..hi {
+            let v = y(k);
+            if v < vmin || (vmin.is_nan() && !v.is_nan()) {
+                (imin, vmin) = (k, v);
+            }
+            if v > vmax || (vmax.is_nan() && !v.is_nan()) {
+                (imax, vmax) = (k, v);
+            }
+        }
+        let (a, c) = (imin.min(imax), imin.max(imax));
+        out.push(a);
+        if c != a {
+            out.push(c);
+        }
+    }
+    out.push(n - 1);
+    out
+}
+
+/// A curve of the samples `0..n` (x(k), y(k)), decimated to [`PLOT_POINTS`].
+fn curve(name: String, n: usize, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> Curve {
+    let idx = decimate(n, &y, PLOT_POINTS);
+    let xs = idx.iter().map(|&k| x(k)).collect();
+    let ys = idx.iter().map(|&k| y(k)).collect();
+    (name, xs, ys)
+}
+
 /// A line chart.
 #[derive(Debug, Clone)]
 pub struct Figure {
@@ -55,17 +108,12 @@ impl Figure {
 pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
     let n = d.chain.len();
     let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
-    let t: Vec<f64> = r.samples.iter().map(|s| s.t).collect();
+    let m = r.samples.len();
+    let t = |k: usize| r.samples[k].t;
     let per_hinge = |f: &dyn Fn(&Sample, usize) -> f64| -> Vec<Curve> {
         shown
             .iter()
-            .map(|&i| {
-                (
-                    format!("hinge {}", i + 1),
-                    t.clone(),
-                    r.samples.iter().map(|s| f(s, i)).collect(),
-                )
-            })
+            .map(|&i| curve(format!("hinge {}", i + 1), m, t, |k| f(&r.samples[k], i)))
             .collect()
     };
     let fig = |stem: &str, title: &str, ylabel: &'static str, curves| Figure {
@@ -78,13 +126,7 @@ pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
     let hub: Vec<Curve> = ["u [m]", "v [m]", "θ [rad]"]
         .iter()
         .enumerate()
-        .map(|(k, l)| {
-            (
-                format!("hub {l}"),
-                t.clone(),
-                r.samples.iter().map(|s| s.hub[k]).collect(),
-            )
-        })
+        .map(|(j, l)| curve(format!("hub {l}"), m, t, |k| r.samples[k].hub[j]))
         .collect();
     vec![
         fig(
@@ -118,19 +160,14 @@ pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
 /// corners, hub translation and rotation) and the first eight elastic modal amplitudes.
 pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
     let hist = &r.history;
-    let t = &hist.times;
+    let n = hist.times.len();
+    let t = |k: usize| hist.times[k];
     let pick = |f: &dyn Fn(&Channel) -> bool| -> Vec<Curve> {
         r.channels
             .iter()
             .enumerate()
             .filter(|(_, c)| f(c))
-            .map(|(j, c)| {
-                (
-                    c.label.clone(),
-                    t.clone(),
-                    (0..t.len()).map(|k| hist.values[(k, j)]).collect(),
-                )
-            })
+            .map(|(j, c)| curve(c.label.clone(), n, t, |k| hist.values[(k, j)]))
             .collect()
     };
     let fig = |stem: String, title: String, ylabel: &'static str, curves| Figure {
@@ -140,13 +177,20 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         ylabel,
         curves,
     };
+    // File stems of the components' figures: sanitised, distinct (names::file_stems).
+    let st = &s.structure;
+    let names: Vec<&str> = (st.beams.iter().map(|b| b.name.as_str()))
+        .chain(st.plates.iter().map(|p| p.name.as_str()))
+        .chain(st.masses.iter().map(|m| m.name.as_str()))
+        .collect();
+    let stems = super::file_stems(&names);
     let mut out = Vec::new();
-    for b in &s.structure.beams {
+    for (b, stem) in st.beams.iter().zip(&stems) {
         let kind = ChannelKind::BeamTip {
             beam: b.name.clone(),
         };
         out.push(fig(
-            format!("response_{}_tip", b.name),
+            format!("response_{stem}_tip"),
             format!(
                 "{} tip: elastic deflection in both bending planes (fig. 2.4)",
                 b.name
@@ -155,18 +199,18 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
             pick(&|c| c.kind == kind && c.unit == "m"),
         ));
         out.push(fig(
-            format!("response_{}_twist", b.name),
+            format!("response_{stem}_twist"),
             format!("{} tip: elastic twist (fig. 2.4)", b.name),
             "twist [rad]",
             pick(&|c| c.kind == kind && c.unit == "rad"),
         ));
     }
-    for p in &s.structure.plates {
+    for (p, stem) in st.plates.iter().zip(&stems[st.beams.len()..]) {
         let kind = ChannelKind::PlateTip {
             plate: p.name.clone(),
         };
         out.push(fig(
-            format!("response_{}_tip", p.name),
+            format!("response_{stem}_tip"),
             format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
             "deflection [m]",
             pick(&|c| c.kind == kind),
@@ -192,15 +236,12 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         .filter(|(_, m)| !m.rigid)
         .take(8)
         .map(|(j, m)| {
-            (
-                format!(
-                    "mode {} ({:.3} Hz)",
-                    m.number,
-                    m.omega / (2.0 * std::f64::consts::PI)
-                ),
-                t.clone(),
-                (0..t.len()).map(|k| hist.modal[(k, j)]).collect(),
-            )
+            let name = format!(
+                "mode {} ({:.3} Hz)",
+                m.number,
+                m.omega / (2.0 * std::f64::consts::PI)
+            );
+            curve(name, n, t, |k| hist.modal[(k, j)])
         })
         .collect();
     out.push(fig(
@@ -210,4 +251,70 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         modal,
     ));
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn signal(n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|k| {
+                let t = k as f64 * 1e-3;
+                (7.0 * t).sin() * (-0.1 * t).exp() + 0.3 * (313.0 * t).sin()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn short_series_are_unchanged() {
+        for n in [0, 1, 2, 5, PLOT_POINTS] {
+            assert_eq!(
+                decimate(n, |k| k as f64, PLOT_POINTS),
+                (0..n).collect::<Vec<_>>()
+            );
+        }
+    }
+
+    #[test]
+    fn long_series_keep_ends_order_and_every_extremum() {
+        for n in [PLOT_POINTS + 1, 10_007, 1_000_000] {
+            let mut y = signal(n);
+            // Isolated spikes, one sample wide, must survive.
+            y[n / 3] = 50.0;
+            y[2 * n / 3] = -60.0;
+            let idx = decimate(n, |k| y[k], PLOT_POINTS);
+            assert!(
+                idx.len() <= PLOT_POINTS && idx.len() > PLOT_POINTS / 2,
+                "{n}: {}",
+                idx.len()
+            );
+            assert_eq!((idx[0], *idx.last().unwrap()), (0, n - 1));
+            assert!(idx.windows(2).all(|w| w[0] < w[1]), "{n}: not increasing");
+            let kept: Vec<f64> = idx.iter().map(|&k| y[k]).collect();
+            let max = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+            let min = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
+            assert_eq!(max(&kept), 50.0);
+            assert_eq!(min(&kept), -60.0);
+            // Every run's minimum and maximum are kept (the runs as documented).
+            let (inner, runs) = (n - 2, (PLOT_POINTS - 2) / 2);
+            for b in 0..runs {
+                let run = &y[1 + b * inner / runs..1 + (b + 1) * inner / runs];
+                assert!(
+                    kept.contains(&max(run)) && kept.contains(&min(run)),
+                    "{n}: run {b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn nan_is_not_picked_over_numbers() {
+        let n = 20_000;
+        let mut y = signal(n);
+        y[1000] = f64::NAN;
+        let idx = decimate(n, |k| y[k], 100);
+        assert!(idx.iter().all(|&k| k != 1000));
+        assert!(idx.len() <= 100);
+    }
 }

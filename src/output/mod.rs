@@ -5,6 +5,7 @@ mod atomic;
 mod deploy;
 pub mod figures;
 mod modes;
+mod names;
 pub mod plot;
 mod report;
 mod simulate;
@@ -12,6 +13,7 @@ mod simulate;
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
+pub use names::file_stems;
 pub use report::report_html;
 pub use simulate::{simulate_json, simulate_table, write_simulate};
 

@@ -1,5 +1,6 @@
 //! Modal-analysis outputs: table, JSON, CSV, mode-shape samples and pictures.
 
+use super::names::csv_bytes;
 use super::{plot, OutputDir, OutputError};
 use crate::ritz::shapes::{sample_beam, sample_plate, PointSample};
 use crate::ritz::{ElementBasis, ModalAnalysis, Mode, RitzModel};
@@ -199,91 +200,114 @@ pub fn write_modes(
         .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
         .map(|e| st.component_name(e.id).to_string())
         .collect();
-    let mut f = String::from("mode,rigid,frequency [Hz],omega [rad/s],dominant");
-    for n in &names {
-        let _ = write!(f, ",strain energy share {n} [-]");
-    }
-    for d in DIRECTIONS {
-        let unit = if d.starts_with('r') { "kg m^2" } else { "kg" };
-        let _ = write!(f, ",effective mass {d} [{unit}]");
-    }
-    f.push('\n');
-    for m in &modes.modes {
-        let _ = write!(
-            f,
-            "{},{},{},{},{}",
-            m.number,
-            m.rigid,
-            csv_num(m.frequency_hz()),
-            csv_num(m.omega_rad_s),
-            m.dominant()
-        );
-        for n in &names {
-            let v = m.share(n).unwrap_or(0.0);
-            let _ = write!(f, ",{}", csv_num(v));
+    let f = csv_bytes(|w| {
+        let mut header: Vec<String> = [
+            "mode",
+            "rigid",
+            "frequency [Hz]",
+            "omega [rad/s]",
+            "dominant",
+        ]
+        .map(String::from)
+        .to_vec();
+        header.extend(names.iter().map(|n| format!("strain energy share {n} [-]")));
+        for d in DIRECTIONS {
+            let unit = if d.starts_with('r') { "kg m^2" } else { "kg" };
+            header.push(format!("effective mass {d} [{unit}]"));
         }
-        for d in 0..6 {
-            match m.effective_mass {
-                Some(e) => {
-                    let _ = write!(f, ",{}", csv_num(e[d]));
-                }
-                None => f.push(','),
+        w.write_record(&header)?;
+        for m in &modes.modes {
+            w.write_field(m.number.to_string())?;
+            w.write_field(m.rigid.to_string())?;
+            w.write_field(csv_num(m.frequency_hz()))?;
+            w.write_field(csv_num(m.omega_rad_s))?;
+            w.write_field(m.dominant())?;
+            for n in &names {
+                w.write_field(csv_num(m.share(n).unwrap_or(0.0)))?;
             }
+            for d in 0..6 {
+                w.write_field(m.effective_mass.map_or(String::new(), |e| csv_num(e[d])))?;
+            }
+            w.write_record(None::<&[u8]>)?;
         }
-        f.push('\n');
-    }
+        Ok(())
+    })?;
     dir.write("frequencies.csv", f)?;
 
     for m in &modes.modes {
         // Coefficients grouped by component and field: the paper's tables 2.2–2.3.
-        let mut c = String::from("component,field,i,j,coefficient [mass-normalised]\n");
-        if st.hub.motion == HubMotion::Free {
-            for (k, d) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
-                let _ = writeln!(c, "hub,{d},{},,{}", k + 1, csv_num(m.shape[k]));
+        let c = csv_bytes(|w| {
+            w.write_record([
+                "component",
+                "field",
+                "i",
+                "j",
+                "coefficient [mass-normalised]",
+            ])?;
+            if st.hub.motion == HubMotion::Free {
+                for (k, d) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
+                    w.write_record([
+                        "hub",
+                        d,
+                        (k + 1).to_string().as_str(),
+                        "",
+                        csv_num(m.shape[k]).as_str(),
+                    ])?;
+                }
             }
-        }
-        for e in &model.elements {
-            let name = st.component_name(e.id);
-            let ny = match (&e.basis, e.id) {
-                (ElementBasis::Plate { width, .. }, _) => width.len(),
-                _ => 0,
-            };
-            for fr in &e.fields {
-                for k in 0..fr.len {
-                    let v = csv_num(m.shape[fr.start + k]);
-                    match (k.checked_div(ny), k.checked_rem(ny)) {
-                        (Some(i), Some(j)) => {
-                            let _ = writeln!(c, "{name},{},{},{},{v}", fr.field, i + 1, j + 1);
-                        }
-                        _ => {
-                            let _ = writeln!(c, "{name},{},{},,{v}", fr.field, k + 1);
-                        }
+            for e in &model.elements {
+                let name = st.component_name(e.id);
+                let ny = match (&e.basis, e.id) {
+                    (ElementBasis::Plate { width, .. }, _) => width.len(),
+                    _ => 0,
+                };
+                for fr in &e.fields {
+                    for k in 0..fr.len {
+                        let v = csv_num(m.shape[fr.start + k]);
+                        let (i, j) = match (k.checked_div(ny), k.checked_rem(ny)) {
+                            (Some(i), Some(j)) => ((i + 1).to_string(), (j + 1).to_string()),
+                            _ => ((k + 1).to_string(), String::new()),
+                        };
+                        w.write_record([name, fr.field, i.as_str(), j.as_str(), v.as_str()])?;
                     }
                 }
             }
-        }
+            Ok(())
+        })?;
         dir.write(&format!("coefficients/mode_{:03}.csv", m.number), c)?;
 
-        let mut sh = String::from("component,s [m],t [m],x [m],y [m],z [m],ux [m],uy [m],uz [m],rx [rad],ry [rad],rz [rad]\n");
-        for (name, _, samples) in sample_all(model, &m.shape) {
-            for p in samples {
-                let _ = writeln!(
-                    sh,
-                    "{name},{},{},{},{},{},{},{},{},{},{},{}",
-                    csv_num(p.local[0]),
-                    csv_num(p.local[1]),
-                    csv_num(p.position.0[0]),
-                    csv_num(p.position.0[1]),
-                    csv_num(p.position.0[2]),
-                    csv_num(p.displacement.0[0]),
-                    csv_num(p.displacement.0[1]),
-                    csv_num(p.displacement.0[2]),
-                    csv_num(p.rotation.0[0]),
-                    csv_num(p.rotation.0[1]),
-                    csv_num(p.rotation.0[2]),
-                );
+        let sh = csv_bytes(|w| {
+            w.write_record([
+                "component",
+                "s [m]",
+                "t [m]",
+                "x [m]",
+                "y [m]",
+                "z [m]",
+                "ux [m]",
+                "uy [m]",
+                "uz [m]",
+                "rx [rad]",
+                "ry [rad]",
+                "rz [rad]",
+            ])?;
+            for (name, _, samples) in sample_all(model, &m.shape) {
+                for p in samples {
+                    w.write_field(&name)?;
+                    for v in p
+                        .local
+                        .iter()
+                        .chain(&p.position.0)
+                        .chain(&p.displacement.0)
+                        .chain(&p.rotation.0)
+                    {
+                        w.write_field(csv_num(*v))?;
+                    }
+                    w.write_record(None::<&[u8]>)?;
+                }
             }
-        }
+            Ok(())
+        })?;
         dir.write(&format!("shapes/mode_{:03}.csv", m.number), sh)?;
     }
     let first_elastic = modes.modes.iter().position(|m| !m.rigid).unwrap_or(0);

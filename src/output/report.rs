@@ -9,6 +9,7 @@
 //! summary.json) and `data-value` (the full-precision value), which the tests compare.
 
 use super::figures::Figure;
+use super::names::{html as esc, script_json as embed};
 use super::plot::mode_shape_svg;
 use super::OutputError;
 use crate::deploy::chain::PlanarHub;
@@ -22,15 +23,8 @@ use std::fmt::Write;
 
 const SCRIPT: &str = include_str!("../../assets/report.js");
 const STYLE: &str = include_str!("../../assets/report.css");
-
-/// HTML-escapes user text (component names, file names).
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-        .replace('\'', "&#39;")
-}
+/// Most frames in the deployment animation (every example has fewer samples than this).
+const ANIMATION_FRAMES: usize = 4000;
 
 /// A table cell with a value that summary.json also holds.
 fn keyed(key: &str, v: f64, shown: String) -> String {
@@ -44,13 +38,6 @@ fn round7(v: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// JSON for a `<script type="application/json">` block ("</" cannot close the element).
-fn embed(v: &Value) -> String {
-    serde_json::to_string(v)
-        .unwrap_or_default()
-        .replace("</", "<\\/")
 }
 
 /// An interactive chart of a figure (data rounded to 7 significant digits).
@@ -440,9 +427,12 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
         r.final_time
     );
     // Animation frames: the hinge points of every sample, in the deployment plane.
-    let frames: Vec<Value> = r
-        .samples
-        .iter()
+    // At most ANIMATION_FRAMES of them, evenly spaced, the first and the last included.
+    let m = r.samples.len();
+    let step = m.div_ceil(ANIMATION_FRAMES).max(1);
+    let frames: Vec<Value> = (0..m)
+        .filter(|k| k % step == 0 || k + 1 == m)
+        .map(|k| &r.samples[k])
         .map(|smp| {
             json!({"t": round7(smp.t),
                    "p": smp.hinges.iter().map(|p| [round7(p[0]), round7(p[1])]).collect::<Vec<_>>(),

@@ -1,6 +1,7 @@
 //! `flexcraft simulate` outputs: the terminal summary, summary.json, response.csv and the
 //! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
 
+use super::names::csv_writer;
 use super::{deploy_table, modes_json, num, write_deploy, OutputDir, OutputError};
 use crate::math::Vec3;
 use crate::response::ChannelKind;
@@ -311,28 +312,37 @@ pub fn write_simulate(
     let Some(r) = &sim.response else {
         return Ok(());
     };
+    // response.csv, streamed to the file: it can hold millions of rows.
     let hist = &r.history;
-    let mut c = String::from("t [s]");
-    for ch in &r.channels {
-        let _ = write!(c, ",{} [{}]", ch.name, ch.unit);
-    }
-    for m in &r.modal.modes {
-        let _ = write!(c, ",eta_{} [√kg·m]", m.number);
-    }
-    c.push('\n');
+    let file = std::fs::File::create(dir.path("response.csv")?)?;
+    let mut w = csv_writer(std::io::BufWriter::with_capacity(1 << 16, file));
+    let mut header = vec!["t [s]".to_string()];
+    header.extend(
+        r.channels
+            .iter()
+            .map(|ch| format!("{} [{}]", ch.name, ch.unit)),
+    );
+    header.extend(
+        r.modal
+            .modes
+            .iter()
+            .map(|m| format!("eta_{} [√kg·m]", m.number)),
+    );
+    let csv_err = |e: csv::Error| OutputError::Io(std::io::Error::other(e));
+    w.write_record(&header).map_err(csv_err)?;
     for (k, &t) in hist.times.iter().enumerate() {
-        c.push_str(&num(t));
+        w.write_field(num(t)).map_err(csv_err)?;
         for j in 0..r.channels.len() {
-            c.push(',');
-            c.push_str(&num(hist.values[(k, j)]));
+            w.write_field(num(hist.values[(k, j)])).map_err(csv_err)?;
         }
         for j in 0..r.modal.modes.len() {
-            c.push(',');
-            c.push_str(&num(hist.modal[(k, j)]));
+            w.write_field(num(hist.modal[(k, j)])).map_err(csv_err)?;
         }
-        c.push('\n');
+        w.write_record(None::<&[u8]>).map_err(csv_err)?;
     }
-    dir.write("response.csv", c)?;
+    // Flushes the csv buffer and the BufWriter, reporting any error.
+    w.into_inner()
+        .map_err(|e| OutputError::Io(std::io::Error::other(e.to_string())))?;
 
     for f in super::figures::response_figures(s, r) {
         f.draw(dir)?;

@@ -1,5 +1,11 @@
 //! Rayleigh–Ritz synthesis of the deployed structure: assembly of M and K, the generalized
 //! eigenproblem, and the modes with their energy shares and effective masses.
+//!
+//! Determinism: faer is built without its "rayon" feature (Cargo.toml), so its global
+//! parallelism is `Par::Seq` and every reduction runs in one fixed order: the modes, and
+//! everything computed from them, are bit-for-bit the same whatever the core count or
+//! `RAYON_NUM_THREADS`. (A dependent crate that turns faer's "rayon" feature back on would
+//! re-enable parallel, thread-count-dependent rounding; the test below guards this crate.)
 
 pub mod assembly;
 pub mod eigen;
@@ -23,4 +29,14 @@ pub enum RitzError {
     /// The symmetric eigensolver did not converge.
     #[error("the symmetric eigensolver did not converge")]
     EigenNoConvergence,
+}
+
+#[cfg(test)]
+mod tests {
+    /// faer must run sequentially: parallel reductions round differently on different core
+    /// counts, which would break the byte-identical outputs.
+    #[test]
+    fn faer_runs_sequentially() {
+        assert!(matches!(faer::get_global_parallelism(), faer::Par::Seq));
+    }
 }
