@@ -144,7 +144,7 @@ mass = 5.0
 /// Runs `simulate` through the library and writes its outputs into `out`.
 fn write_simulate(s: &flexcraft::Scenario, out: &Path) -> flexcraft::simulation::Simulation {
     let sim = flexcraft::simulation::Simulation::run(s).unwrap();
-    let mut dir = flexcraft::output::OutputDir::create(out).unwrap();
+    let mut dir = flexcraft::output::OutputDir::create(out, false).unwrap();
     flexcraft::output::write_simulate(&mut dir, s, &sim, b"hostile", "<!--x.toml").unwrap();
     flexcraft::output::write_modes(&mut dir, &sim.model, &sim.modes).unwrap();
     dir.commit().unwrap();
@@ -206,6 +206,9 @@ fn hostile_names_are_escaped_for_every_destination() {
             "{f:?}"
         );
         let name = f.file_name().unwrap().to_str().unwrap();
+        if name == ".flexcraft-output" {
+            continue; // flexcraft's own marker of an output folder
+        }
         assert!(!name.starts_with('.'), "{f:?}");
         assert!(
             name.chars()
