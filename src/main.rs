@@ -18,58 +18,47 @@ struct Cli {
     command: Command,
 }
 
+/// What every command takes: the scenario, the output choices and the memory budget.
+#[derive(clap::Args)]
+struct Common {
+    /// Scenario file (TOML, format version 1; see docs/scenario.md; at most 16 MiB).
+    scenario: PathBuf,
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    json: bool,
+    /// Also write the command's files here (listed above). The folder appears whole when the
+    /// run is complete, or not at all.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
+    /// marker). DIR is always replaced as a whole, never merged into.
+    #[arg(long, requires = "out")]
+    force: bool,
+    /// Refuse a run whose estimated peak memory exceeds this many bytes (suffixes K, M, G,
+    /// T: powers of 1024). Default: half of the machine's memory.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    max_memory: Option<u64>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Natural frequencies and mode shapes of the deployed spacecraft (Rayleigh–Ritz).
+    /// --out writes modes.json, frequencies.csv, coefficient and shape CSVs and plots.
     #[command(after_help = UNITS)]
-    Modes {
-        /// Scenario file (TOML, format version 1; see docs/scenario.md).
-        scenario: PathBuf,
-        /// Print one JSON object on stdout instead of the table.
-        #[arg(long)]
-        json: bool,
-        /// Also write modes.json, frequencies.csv, coefficient and shape CSVs and plots here.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
-        /// marker). DIR is always replaced as a whole, never merged into.
-        #[arg(long, requires = "out")]
-        force: bool,
-    },
+    Modes(#[command(flatten)] Common),
     /// Deployment of the accordion-folded array in [deployment]: hinge springs, loads,
-    /// latching with impact, hub disturbance.
+    /// latching with impact, hub disturbance. --out writes deployment.csv, events.json and
+    /// plots.
     #[command(after_help = UNITS)]
-    Deploy {
-        /// Scenario file (TOML, format version 1, with a [deployment] section).
-        scenario: PathBuf,
-        /// Print one JSON object on stdout instead of the event table.
-        #[arg(long)]
-        json: bool,
-        /// Also write deployment.csv, events.json and plots here.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
-        /// marker). DIR is always replaced as a whole, never merged into.
-        #[arg(long, requires = "out")]
-        force: bool,
-    },
+    Deploy(#[command(flatten)] Common),
     /// The whole story: modes of the deployed spacecraft, deployment of the array, hand-over
     /// at the final latch and the latch-excited vibration, hub drift and attitude motion.
+    /// --out writes report.html (one self-contained page), summary.json, modes.json,
+    /// deployment.csv, events.json, response.csv and plots.
     #[command(after_help = UNITS)]
     Simulate {
-        /// Scenario file (TOML, format version 1, with [deployment] and optionally [response]).
-        scenario: PathBuf,
-        /// Print summary.json on stdout instead of the summary table.
-        #[arg(long)]
-        json: bool,
-        /// Also write report.html (one self-contained page), summary.json, modes.json,
-        /// deployment.csv, events.json, response.csv and plots here.
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Replace DIR even if it exists and was not written by flexcraft (no .flexcraft-output
-        /// marker). DIR is always replaced as a whole, never merged into.
-        #[arg(long, requires = "out")]
-        force: bool,
+        #[command(flatten)]
+        common: Common,
         /// Open DIR/report.html in the default browser when done (needs --out).
         #[arg(long, requires = "out")]
         open: bool,
@@ -82,28 +71,50 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let done = match cli.command {
-        Command::Modes {
-            scenario,
-            json,
-            out,
-            force,
-        } => run_modes(&scenario, json, out.as_deref(), force),
-        Command::Deploy {
-            scenario,
-            json,
-            out,
-            force,
-        } => run_deploy(&scenario, json, out.as_deref(), force),
+        Command::Modes(c) => run_modes(&c),
+        Command::Deploy(c) => run_deploy(&c),
         Command::Simulate {
-            scenario,
-            json,
-            out,
-            force,
+            common,
             open,
             quiet,
-        } => run_simulate(&scenario, json, out.as_deref(), force, open, quiet),
+        } => run_simulate(&common, open, quiet),
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
+}
+
+/// "4G", "512M", "1000000" → bytes (K, M, G, T are powers of 1024).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (num, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a size: {s:?} (e.g. 4G, 512M, 1000000)"))?;
+    let bytes = v * (1u64 << shift) as f64;
+    if bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64 {
+        Ok(bytes as u64)
+    } else {
+        Err(format!("not a size: {s:?} (e.g. 4G, 512M, 1000000)"))
+    }
+}
+
+/// Half of the machine's memory (Linux: MemTotal of /proc/meminfo), or 8 GiB when unknown.
+fn default_memory_budget() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|m| {
+            m.lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or(8 << 30, |kb| kb * 1024 / 2)
 }
 
 /// Exit statuses: 2 the input was refused (the scenario, a missing section the command
@@ -113,12 +124,17 @@ fn main() -> ExitCode {
 const REFUSED: u8 = 2;
 const FAILED: u8 = 1;
 
-/// Reads and validates the scenario, reporting a refusal with its location.
-fn load(path: &Path) -> Result<Scenario, ExitCode> {
-    Scenario::from_file(path).map_err(|e| {
+/// Reads and validates the scenario and checks that the run fits the memory budget,
+/// reporting a refusal with its location.
+fn load(c: &Common) -> Result<Scenario, ExitCode> {
+    let refuse = |e: flexcraft::scenario::ScenarioError| {
         eprintln!("error: {e}");
         ExitCode::from(REFUSED)
-    })
+    };
+    let s = Scenario::from_file(&c.scenario).map_err(refuse)?;
+    s.check_budget(c.max_memory.unwrap_or_else(default_memory_budget))
+        .map_err(refuse)?;
+    Ok(s)
 }
 
 /// The `[deployment]` section a command needs.
@@ -204,9 +220,10 @@ fn finish(
     Ok(())
 }
 
-fn run_modes(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Result<(), ExitCode> {
-    let scenario = load(path)?;
-    let staged = prepare(out, force)?;
+fn run_modes(c: &Common) -> Result<(), ExitCode> {
+    let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
+    let scenario = load(c)?;
+    let staged = prepare(out, c.force)?;
     let model = RitzModel::assemble(&scenario.structure);
     let modes =
         ModalAnalysis::compute(&model).map_err(|e| numerical_failure(&scenario, &model, &e))?;
@@ -220,10 +237,11 @@ fn run_modes(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Result
     )
 }
 
-fn run_deploy(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Result<(), ExitCode> {
-    let scenario = load(path)?;
+fn run_deploy(c: &Common) -> Result<(), ExitCode> {
+    let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
+    let scenario = load(c)?;
     let d = need_deployment(path, &scenario)?;
-    let staged = prepare(out, force)?;
+    let staged = prepare(out, c.force)?;
     let result = flexcraft::deploy::simulate(d);
     not_finite(path, flexcraft::finite::check_deployment(&result))?;
     finish(
@@ -235,20 +253,14 @@ fn run_deploy(path: &Path, json: bool, out: Option<&Path>, force: bool) -> Resul
     )
 }
 
-fn run_simulate(
-    path: &Path,
-    json: bool,
-    out: Option<&Path>,
-    force: bool,
-    open: bool,
-    quiet: bool,
-) -> Result<(), ExitCode> {
+fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     use flexcraft::simulation::Simulation;
+    let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let started = std::time::Instant::now();
     let progress = Progress::new(quiet);
-    let scenario = load(path)?;
+    let scenario = load(c)?;
     need_deployment(path, &scenario)?;
-    let staged = prepare(out, force)?;
+    let staged = prepare(out, c.force)?;
     let source = std::fs::read(path).unwrap_or_default();
     progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| match &e {

@@ -49,8 +49,10 @@ impl Vec3 {
     /// NaN components; callers check for it.
     pub fn normalized(self) -> Vec3 {
         let big = self.0.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-        let s = self * (1.0 / big);
-        s * (1.0 / s.norm())
+        // Divide (not multiply by 1/big): the reciprocal of a subnormal overflows.
+        let s = Vec3(self.0.map(|x| x / big));
+        let n = s.norm();
+        Vec3(s.0.map(|x| x / n))
     }
 
     /// Component i.

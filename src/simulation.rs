@@ -87,6 +87,7 @@ impl Simulation {
                 }
                 let channels = standard_channels(&model);
                 let history = modal.sample(&modes, &channels, settings);
+                warnings.extend(large_deflections(&model, &channels, &history));
                 Some(Response {
                     handover,
                     modal,
@@ -110,4 +111,49 @@ impl Simulation {
             warnings,
         })
     }
+}
+
+/// Largest elastic deflection, as a fraction of the component's length, that the linear
+/// (small-deformation) model is trusted with; above it a warning says so.
+pub const SMALL_DEFLECTION_FRACTION: f64 = 0.1;
+
+/// Warnings for beam and plate tips whose peak elastic deflection exceeds
+/// [`SMALL_DEFLECTION_FRACTION`] of the component's length: the linear model's numbers are
+/// then outside its assumption (small deflections about the deployed configuration).
+fn large_deflections(
+    model: &RitzModel,
+    channels: &[Channel],
+    history: &ResponseHistory,
+) -> Vec<String> {
+    use crate::response::ChannelKind;
+    let st = &model.structure;
+    let mut out = Vec::new();
+    for (j, c) in channels.iter().enumerate() {
+        let length = match &c.kind {
+            ChannelKind::BeamTip { beam } if c.unit == "m" => {
+                st.beams.iter().find(|b| &b.name == beam).map(|b| b.length)
+            }
+            ChannelKind::PlateTip { plate } => st
+                .plates
+                .iter()
+                .find(|p| &p.name == plate)
+                .map(|p| p.length),
+            _ => None,
+        };
+        let Some(length) = length else { continue };
+        let peak = (0..history.times.len())
+            .map(|k| history.values[(k, j)].abs())
+            .fold(0.0_f64, f64::max);
+        if peak > SMALL_DEFLECTION_FRACTION * length {
+            out.push(format!(
+                "{}: peak elastic deflection {peak:.6e} m is {:.1} % of the component's length \
+                 {length} m: the linear (small-deformation) model is outside its assumption \
+                 there (more than {} %)",
+                c.label,
+                100.0 * peak / length,
+                100.0 * SMALL_DEFLECTION_FRACTION
+            ));
+        }
+    }
+    out
 }

@@ -11,6 +11,7 @@ mod suite {
     pub mod deploy;
     pub mod deploy_maximal;
     pub mod exact_beams;
+    pub mod hardening_input;
     pub mod hardening_output;
     pub mod modal_properties;
     pub mod mutations;

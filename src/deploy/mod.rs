@@ -177,8 +177,15 @@ fn sample(chain: &Chain, t: f64, y: &[f64], free: &[bool]) -> Sample {
     }
 }
 
-/// Runs the deployment until every hinge has latched or `end_time`.
+/// Runs the deployment until every hinge has latched or `end_time` (at most [`MAX_STEPS`]
+/// steps).
 pub fn simulate(d: &Deployment) -> DeploymentResult {
+    simulate_limited(d, MAX_STEPS)
+}
+
+/// [`simulate`] with a step limit of the caller's choosing: the run stops after `max_steps`
+/// steps with [`DeploymentResult::step_limit_reached`] set.
+pub fn simulate_limited(d: &Deployment, max_steps: usize) -> DeploymentResult {
     let chain = &d.chain;
     let n = chain.dof();
     let h = chain.hub_dof();
@@ -218,7 +225,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         }
     };
 
-    while t < d.end_time && sys.free[h..].iter().any(|f| *f) && steps < MAX_STEPS {
+    while t < d.end_time && sys.free[h..].iter().any(|f| *f) && steps < max_steps {
         steps += 1;
         let t_start = t;
         let y_start = y.clone();
@@ -367,7 +374,7 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
         unlatched,
         swing_back: swing.into_iter().flatten().collect(),
         evaluations: solver.evaluations,
-        step_limit_reached: steps >= MAX_STEPS && !diverged && t < d.end_time && !all_latched,
+        step_limit_reached: steps >= max_steps && !diverged && t < d.end_time && !all_latched,
         diverged,
     }
 }

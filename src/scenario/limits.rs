@@ -127,12 +127,12 @@ pub const MAX_PANELS: usize = 100;
 /// Relative integration tolerance.
 pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
 /// Deployment end time and response duration.
-pub const DURATION: Limit = above(0.0, 1e6, "s");
+pub const DURATION: Limit = closed(1e-6, 1e6, "s");
 /// Modal damping ratio of the response, [0, 1): an underdamped structure (1 itself is
 /// refused by the scenario layer).
 pub const DAMPING_RATIO: Limit = closed(0.0, 1.0, "");
 /// Output sample rates.
-pub const OUTPUT_RATE: Limit = above(0.0, 1e5, "Hz");
+pub const OUTPUT_RATE: Limit = closed(1e-3, 1e5, "Hz");
 
 /// Longest component or material name, characters.
 pub const MAX_NAME: usize = 64;
@@ -196,10 +196,12 @@ mod tests {
         assert!(!LENGTH.contains(f64::INFINITY));
         assert!(!DURATION.contains(0.0));
         assert!(!DURATION.contains(-0.0));
+        assert!(!OUTPUT_RATE.contains(5e-324));
         assert!(HINGE_DAMPING.contains(-0.0));
         assert!(!MASS.contains(5e-324));
         assert_eq!(LENGTH.describe(), "[1e-3, 1e4] m");
-        assert_eq!(DURATION.describe(), "(0, 1e6] s");
+        assert_eq!(DURATION.describe(), "[1e-6, 1e6] s");
+        assert_eq!(POISSON.describe(), "(-1, 0.5]");
     }
 
     #[test]

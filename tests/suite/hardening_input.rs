@@ -1,0 +1,374 @@
+//! Hardening of the input side: hostile names, oversized or non-UTF-8 files, values outside
+//! their accepted ranges, memory budgets, step limits, located numerical failures, scale-safe
+//! directions and the small-deformation warning. Each refusal is checked through the binary
+//! (file:line:column, key, reason, exit 2, nothing written) or through the library.
+
+use flexcraft::simulation::Simulation;
+use flexcraft::structure::ComponentId;
+use flexcraft::{ModalAnalysis, RitzModel, Scenario};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const SEED: &str = include_str!("../../examples/seed.toml");
+const FREE_HUB: &str = include_str!("../../examples/free_hub.toml");
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_flexcraft"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("flexcraft-hin-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes `src` as `dir/scenario.toml` and runs `flexcraft SUB it --out dir/out ARGS`.
+fn run(dir: &Path, sub: &str, src: impl AsRef<[u8]>, args: &[&str]) -> Output {
+    let f = dir.join("scenario.toml");
+    std::fs::write(&f, src).unwrap();
+    bin()
+        .arg(sub)
+        .arg(&f)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Exit 2, one line `file:LINE:col: KEY…: …REASON…`, and nothing but the scenario in `dir`.
+fn assert_refused(dir: &Path, out: &Output, line: usize, key: &str, reason: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let loc = format!("scenario.toml:{line}:");
+    assert!(err.contains(&loc), "no {loc} in: {err}");
+    assert!(err.contains(&format!(" {key}")), "no key {key} in: {err}");
+    assert!(err.contains(reason), "no reason {reason:?} in: {err}");
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(left, ["scenario.toml"], "{err}");
+}
+
+/// The 1-based line of the first occurrence of `needle` in `src`.
+fn line_of(src: &str, needle: &str) -> usize {
+    let at = src
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle} not in source"));
+    src[..at].matches('\n').count() + 1
+}
+
+#[test]
+fn hostile_names_are_refused_at_parse_time_and_nothing_is_written_anywhere() {
+    let dir = scratch("names");
+    let escape = dir.join("SOMEWHERE");
+    for (name, reason) in [
+        (
+            "x/../../../../../../../../SOMEWHERE/pwned",
+            "'/' is not allowed",
+        ),
+        ("hub", "reserved"),
+        ("", "must not be empty"),
+        ("a,b\\n1,2,3\\\"q", "not allowed"),
+        ("<!--<script>", "not allowed"),
+        ("..", "start with a letter or a digit"),
+    ] {
+        let src = FREE_HUB.replace("name = \"wing\"", &format!("name = \"{name}\""));
+        let out = run(&dir, "simulate", &src, &[]);
+        assert_refused(
+            &dir,
+            &out,
+            line_of(FREE_HUB, "name = \"wing\""),
+            "plates[0].name",
+            reason,
+        );
+    }
+    assert!(!escape.exists());
+    // A name of a megabyte is refused with a message of one screen.
+    let src = FREE_HUB.replace(
+        "name = \"wing\"",
+        &format!("name = \"{}\"", "w".repeat(1 << 20)),
+    );
+    let out = run(&dir, "modes", &src, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(err.len() < 600, "{} bytes of message", err.len());
+    assert!(err.contains("at most 64 characters"), "{err}");
+}
+
+#[test]
+fn oversized_and_non_utf8_files_are_refused_with_a_location() {
+    let dir = scratch("files");
+    // /dev/zero is cut at 16 MiB instead of read to the end.
+    let out = bin().args(["modes", "/dev/zero"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("larger than 16 MiB"));
+    // An invalid UTF-8 byte on line 5, column 8.
+    let mut bytes = SEED.as_bytes().to_vec();
+    let line5: usize = SEED.match_indices('\n').nth(3).unwrap().0 + 1;
+    bytes.insert(line5 + 7, 0xff);
+    let out = run(&dir, "modes", &bytes, &[]);
+    assert_refused(&dir, &out, 5, "", "not valid UTF-8");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("scenario.toml:5:8:"));
+    // A file of one 5 MB line of comment, CR line ends only: the message stays short.
+    let src = format!("#{}\r[hub]\rmotion = 1", "c".repeat(5 << 20));
+    let out = run(&dir, "modes", src, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        out.stderr.len() < 600,
+        "{} bytes of message",
+        out.stderr.len()
+    );
+}
+
+/// (what, from, to, key, reason): values that used to hang, overflow or print NaN.
+const OUT_OF_RANGE: [(&str, &str, &str, &str, &str); 12] = [
+    (
+        "hub mass huge",
+        "mass = 500.0",
+        "mass = 1e308",
+        "hub.mass",
+        "[1e-6, 1e9] kg",
+    ),
+    (
+        "hub mass subnormal",
+        "mass = 500.0",
+        "mass = 5e-324",
+        "hub.mass",
+        "[1e-6, 1e9] kg",
+    ),
+    (
+        "stiffness",
+        "stiffness = 3.0",
+        "stiffness = 1e308",
+        "deployment.hinge.stiffness",
+        "[0, 1e6]",
+    ),
+    (
+        "damping",
+        "damping = 0.05",
+        "damping = 1e308",
+        "deployment.hinge.damping",
+        "[0, 1e6]",
+    ),
+    (
+        "preload",
+        "preload_angle = 0.3",
+        "preload_angle = 1e308",
+        "deployment.hinge.preload_angle",
+        "rad",
+    ),
+    (
+        "tolerance",
+        "output_rate = 20.0",
+        "output_rate = 20.0\ntolerance = 1e-30",
+        "deployment.tolerance",
+        "[1e-14, 1e-3]",
+    ),
+    (
+        "panels",
+        "panels = 3",
+        "panels = 400",
+        "deployment.panels",
+        "between 1 and 100",
+    ),
+    (
+        "panel lengths",
+        "panels = 3",
+        "panel_lengths = [1e-6, 3.0, 2.999999]",
+        "deployment.panel_lengths",
+        "[1e-3, 1e4] m",
+    ),
+    (
+        "panel ratio",
+        "panels = 3",
+        "panel_lengths = [0.02, 3.0, 2.98]",
+        "deployment.panel_lengths",
+        "more than 100 times",
+    ),
+    (
+        "deployment rows",
+        "end_time = 120.0\noutput_rate = 20.0",
+        "end_time = 1e5\noutput_rate = 1e5",
+        "deployment.output_rate",
+        "the limit is 10000000",
+    ),
+    (
+        "response rate",
+        "output_rate = 100.0",
+        "output_rate = 5e-324",
+        "response.output_rate",
+        "[1e-3, 1e5] Hz",
+    ),
+    (
+        "direction",
+        "normal = [0.0, 0.0, 1.0]",
+        "normal = [0.0, 0.0, 0.0]",
+        "plates[0].normal",
+        "zero length",
+    ),
+];
+
+#[test]
+fn values_outside_their_range_are_refused_with_location_and_key() {
+    let dir = scratch("ranges");
+    for (what, from, to, key, reason) in OUT_OF_RANGE {
+        assert!(FREE_HUB.contains(from), "{what}");
+        let src = FREE_HUB.replacen(from, to, 1);
+        let out = run(&dir, "simulate", &src, &[]);
+        eprintln!("case: {what}");
+        let line = line_of(&src, to.lines().last().unwrap());
+        assert_refused(&dir, &out, line, key, reason);
+    }
+    // A plate's derived stiffness is reported at its thickness, not at its normal.
+    let full = include_str!("../../examples/full.toml");
+    let src = full.replacen("thickness = 0.01", "thickness = 1e110", 1);
+    assert!(src != full);
+    let out = run(&dir, "modes", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "thickness = 1e110"),
+        "plates[0].thickness",
+        "[1e-6, 100] m",
+    );
+    // A lumped mass of 1e-310 kg.
+    let src = full.replacen("mass = 15.0", "mass = 1e-310", 1);
+    assert!(src != full);
+    let out = run(&dir, "modes", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "mass = 1e-310"),
+        "masses[0].mass",
+        "[1e-6, 1e9] kg",
+    );
+}
+
+#[test]
+fn a_run_over_the_memory_budget_is_refused_before_it_starts() {
+    let dir = scratch("budget");
+    // 100 × 100 plate terms: about 15 GiB; refused at the plate's terms under a 1 GiB budget.
+    let src = SEED.replacen(
+        "terms = { length = 8, width = 6 }",
+        "terms = { length = 100, width = 100 }",
+        1,
+    );
+    assert!(src != SEED);
+    let out = run(&dir, "modes", &src, &["--max-memory", "1G"]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "name = \"wing\""),
+        "plates[0].terms",
+        "of memory (limit 1.0 GiB",
+    );
+    // The seed itself fits a generous budget and not a tiny one.
+    let s = Scenario::from_toml_str(SEED, "seed.toml").unwrap();
+    let e = s.check_budget(1 << 30).unwrap();
+    assert_eq!(e.dof as usize, RitzModel::assemble(&s.structure).dof());
+    assert!(s.check_budget(1 << 20).is_err());
+    // The response's rows drive the estimate of a long run.
+    let long = SEED.replacen("duration = 60.0", "duration = 1e5", 1);
+    let s = Scenario::from_toml_str(&long, "long.toml").unwrap();
+    let err = s.check_budget(256 << 20).unwrap_err();
+    assert_eq!(err.key, "response.output_rate");
+    assert_eq!(err.location.line, line_of(&long, "output_rate = 50.0"));
+}
+
+#[test]
+fn a_deployment_that_exceeds_its_step_limit_stops_with_a_status_not_a_hang() {
+    let s = Scenario::from_toml_str(FREE_HUB, "free_hub.toml").unwrap();
+    let d = s.deployment.as_ref().unwrap();
+    let full = flexcraft::deploy::simulate(d);
+    assert!(full.all_latched && !full.step_limit_reached);
+    let cut = flexcraft::deploy::simulate_limited(d, 50);
+    assert!(cut.step_limit_reached);
+    assert!(!cut.all_latched);
+    assert!(cut.final_time > 0.0 && cut.final_time < full.final_time);
+    // The samples written up to the stop are those of the full run (same steps).
+    let k = cut.samples.len() - 1;
+    assert_eq!(cut.samples[k].t, full.samples[k].t);
+    assert_eq!(cut.samples[k].alpha, full.samples[k].alpha);
+    let w = flexcraft::output::deploy_warnings(d, &cut);
+    assert!(
+        w.iter()
+            .any(|w| w.starts_with("step limit reached at t = ")),
+        "{w:?}"
+    );
+}
+
+#[test]
+fn a_direction_of_any_scale_gives_the_same_modes() {
+    // Scale invariance: a direction is a direction. [0, 0, 1e200] used to overflow to zero
+    // in the normalisation and change the first frequency from 1.584 to 0.954 Hz.
+    let freqs = |src: &str| -> Vec<f64> {
+        let s = Scenario::from_toml_str(src, "t.toml").unwrap();
+        let m = ModalAnalysis::compute(&RitzModel::assemble(&s.structure)).unwrap();
+        m.modes.iter().map(|m| m.omega_rad_s).collect()
+    };
+    let base = freqs(FREE_HUB);
+    for scaled in [
+        "[0.0, 0.0, 1e200]",
+        "[0.0, 0.0, 1e-300]",
+        "[0.0, -0.0, 5e-324]",
+    ] {
+        let f = freqs(&FREE_HUB.replace("normal = [0.0, 0.0, 1.0]", &format!("normal = {scaled}")));
+        assert_eq!(f, base, "{scaled}");
+    }
+    let f1 = base.iter().find(|w| **w > 1e-6).unwrap() / (2.0 * std::f64::consts::PI);
+    assert!((f1 - 1.584).abs() < 1e-3, "{f1}");
+}
+
+#[test]
+fn a_numerical_failure_is_traced_to_its_component() {
+    // The coordinate → component map behind located solver failures: the hub's six first,
+    // then each element's own range.
+    let s = Scenario::from_toml_str(SEED, "seed.toml").unwrap();
+    let model = RitzModel::assemble(&s.structure);
+    for k in 0..6 {
+        assert_eq!(model.component_at(k), ComponentId::Hub);
+    }
+    for e in &model.elements {
+        for k in e.own_range() {
+            assert_eq!(model.component_at(k), e.id);
+        }
+    }
+    let pivot = model
+        .element(ComponentId::Plate(0))
+        .unwrap()
+        .own_range()
+        .start
+        + 3;
+    let err = flexcraft::ritz::RitzError::MassNotPositiveDefinite { pivot };
+    let id = model.culprit(&err);
+    assert_eq!(id, ComponentId::Plate(0));
+    let located = s.locate(id, err.to_string());
+    assert_eq!(located.key, "plates[0]");
+    assert_eq!(located.location.line, line_of(SEED, "name = \"wing\""));
+    assert!(located
+        .to_string()
+        .starts_with(&format!("seed.toml:{}:", located.location.line)));
+}
+
+#[test]
+fn deflections_beyond_the_linear_model_are_warned_about() {
+    // A root hinge of 1e6 N·m/rad slams the seed's panels: the linear wing "deflects" by
+    // more than its own length, which the run must say is outside the model.
+    let stiff = SEED.replacen("stiffness = 12.0", "stiffness = 1e6", 1);
+    assert!(stiff != SEED);
+    let s = Scenario::from_toml_str(&stiff, "stiff.toml").unwrap();
+    let sim = Simulation::run(&s).unwrap();
+    assert!(
+        sim.warnings.iter().any(|w| w.contains("small-deformation")),
+        "{:?}",
+        sim.warnings
+    );
+    let calm = Simulation::run(&Scenario::from_toml_str(SEED, "seed.toml").unwrap()).unwrap();
+    assert!(!calm
+        .warnings
+        .iter()
+        .any(|w| w.contains("small-deformation")));
+}
