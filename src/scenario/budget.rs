@@ -5,8 +5,9 @@
 //! The model (measured on the seed structure with plate terms 20×20 … 40×40, peak resident
 //! memory of `flexcraft modes` ≈ 18–20 · 8n² bytes for n generalized coordinates): the
 //! assembly and the generalized eigen-solve hold about [`MATRICES_PER_SOLVE`] dense n × n
-//! matrices at once. Time series cost 8 bytes per number in memory plus about
-//! [`CSV_BYTES_PER_NUMBER`] bytes of CSV text.
+//! matrices at once. Time series cost 8 bytes per number in memory, plus about
+//! [`CSV_BYTES_PER_NUMBER`] bytes of CSV text for the deployment's (the response's CSV is
+//! streamed to its file).
 
 use super::{Scenario, ScenarioError};
 use crate::structure::ComponentId;
@@ -34,11 +35,14 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// Peak memory of the whole run, bytes: the modal solve, then every time series held
-    /// in memory together with its CSV text.
+    /// Peak memory of the whole run, bytes: the modal solve, then the time series.
     pub fn peak_bytes(&self) -> u64 {
-        let series =
-            (self.deployment_cells + self.response_cells).saturating_mul(8 + CSV_BYTES_PER_NUMBER);
+        // The deployment's samples and its CSV text are held in memory together; the
+        // response's history is held as numbers and its CSV streamed to the file.
+        let series = self
+            .deployment_cells
+            .saturating_mul(8 + CSV_BYTES_PER_NUMBER)
+            .saturating_add(self.response_cells.saturating_mul(8));
         BASELINE_BYTES
             .saturating_add(self.modes_bytes)
             .saturating_add(series)
