@@ -19,6 +19,7 @@
 pub mod basis;
 pub mod deploy;
 pub mod finite;
+pub mod limits;
 pub mod math;
 pub mod output;
 pub mod response;

@@ -4,6 +4,7 @@
 
 pub mod chain;
 pub mod integrator;
+pub mod planar;
 
 use chain::{Chain, P2};
 use integrator::{locate, DenseStep, Dopri5, OdeSystem};

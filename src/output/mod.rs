@@ -4,6 +4,8 @@
 mod atomic;
 mod deploy;
 pub mod figures;
+#[cfg(test)]
+mod hostile_names_test;
 mod modes;
 mod names;
 pub mod plot;

@@ -171,7 +171,7 @@ impl RitzModel {
             let t = match att {
                 Attachment::Hub { point } => hub_map(n, *point, hub.center_of_mass),
                 Attachment::Beam { beam, station } => {
-                    let bi = structure.beam_index(beam).expect("parents are validated");
+                    let bi = *beam;
                     let pe = &elements[beam_elem[bi].expect("parents come first")];
                     section_map(&structure.beams[bi], pe, *station, n)
                 }

@@ -1,11 +1,16 @@
-//! The components of the deployed spacecraft (MODEL.md §3.1): hub, beams, plates, lumped masses.
+//! The components of the deployed spacecraft: hub, beams, plates, lumped masses.
 //!
 //! Model limits, stated once: small deflections about the deployed configuration;
 //! Euler–Bernoulli beams without shear deformation or bending rotary inertia (a beam's mass is
 //! a line mass plus the polar inertia ρI_p about its axis); Kirchhoff plates, rigid in their
 //! own plane, thin (the plate's mass is a sheet in its mid-plane); lumped masses rigid.
+//!
+//! Every component is validated by its constructor (the only place each rule is checked;
+//! ranges in [`crate::limits`]) and is read-only afterwards: fields are readable inside the
+//! crate and through accessors outside it.
 
-use super::{finite_vec, positive, rigid::RigidBody, unit, StructureError};
+use super::{in_range, name, point, rigid::RigidBody, unit, Field, Material, StructureError};
+use crate::limits as L;
 use crate::math::{Mat3, Vec3};
 
 /// Whether the hub floats or is held.
@@ -21,55 +26,58 @@ pub enum HubMotion {
 /// its small rotation vector (structure frame).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Hub {
-    /// Free or fixed.
-    pub motion: HubMotion,
-    /// Mass, kg.
-    pub mass: f64,
-    /// Centre of mass, m.
-    pub center_of_mass: Vec3,
-    /// Inertia about the centre of mass, kg·m².
-    pub inertia: Mat3,
+    pub(crate) motion: HubMotion,
+    pub(crate) mass: f64,
+    pub(crate) center_of_mass: Vec3,
+    pub(crate) inertia: Mat3,
+}
+
+/// The paper's hub: a circular cylinder of one material, for [`Hub::cylinder`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cylinder {
+    /// Outer diameter, m.
+    pub diameter: f64,
+    /// Wall thickness, m.
+    pub wall: f64,
+    /// Length, m.
+    pub length: f64,
+    /// Axis direction (any scale).
+    pub axis: Vec3,
+    /// Centre, m.
+    pub center: Vec3,
+    /// Closed by two end discs of the wall's thickness.
+    pub closed_ends: bool,
 }
 
 impl Hub {
-    /// A hub with the given mass properties (inertia already validated by
-    /// [`super::inertia_tensor`]).
+    /// A hub with the given mass properties (inertia from [`super::inertia_tensor`]).
     pub fn new(
         motion: HubMotion,
         mass: f64,
         center_of_mass: Vec3,
         inertia: Mat3,
     ) -> Result<Self, StructureError> {
-        positive("mass", mass)?;
-        finite_vec("center_of_mass", center_of_mass)?;
         Ok(Self {
             motion,
-            mass,
-            center_of_mass,
+            mass: in_range(Field::Mass, mass, L::MASS)?,
+            center_of_mass: point(Field::CenterOfMass, center_of_mass)?,
             inertia,
         })
     }
 
-    /// The paper's hub: a thin-walled circular cylinder (outer diameter, wall) of the given
-    /// length along `axis`, centred at `center`, optionally closed by two end discs of the
-    /// wall's thickness inside the tube. Exact hollow-cylinder formulas:
+    /// A thin-walled circular cylinder of `material`, optionally closed by two end discs of
+    /// the wall's thickness inside the tube. Exact hollow-cylinder formulas:
     /// m = ρπ(R² − r²)L, J_axial = m(R² + r²)/2, J_transverse = m(3(R² + r²) + L²)/12.
-    #[allow(clippy::too_many_arguments)]
     pub fn cylinder(
         motion: HubMotion,
-        diameter: f64,
-        wall: f64,
-        length: f64,
-        axis: Vec3,
-        center: Vec3,
-        density: f64,
-        closed_ends: bool,
+        c: Cylinder,
+        material: &Material,
     ) -> Result<Self, StructureError> {
-        positive("diameter", diameter)?;
-        positive("wall", wall)?;
-        positive("length", length)?;
-        finite_vec("center", center)?;
-        let a = unit("axis", axis)?;
+        let diameter = in_range(Field::Diameter, c.diameter, L::LENGTH)?;
+        let wall = in_range(Field::Wall, c.wall, L::SECTION)?;
+        let length = in_range(Field::Length, c.length, L::LENGTH)?;
+        let a = unit(Field::Axis, c.axis)?;
+        let center = point(Field::Center, c.center)?;
         let big_r = diameter / 2.0;
         if wall >= big_r {
             return Err(StructureError::WallTooThick {
@@ -77,24 +85,24 @@ impl Hub {
                 radius: big_r,
             });
         }
-        if closed_ends && 2.0 * wall >= length {
+        if c.closed_ends && 2.0 * wall >= length {
             return Err(StructureError::WallTooThick {
                 wall,
                 radius: length / 2.0,
             });
         }
+        let density = material.density;
         let r = big_r - wall;
         let along = a.outer(a);
         let across = Mat3::IDENTITY - along;
         let m = density * std::f64::consts::PI * (big_r * big_r - r * r) * length;
-        let tube = RigidBody::from_cm(
+        let mut body = RigidBody::from_cm(
             m,
             Vec3::ZERO,
             along * (m * (big_r * big_r + r * r) / 2.0)
                 + across * (m * (3.0 * (big_r * big_r + r * r) + length * length) / 12.0),
         );
-        let mut body = tube;
-        if closed_ends {
+        if c.closed_ends {
             let md = density * std::f64::consts::PI * r * r * wall;
             let j = along * (md * r * r / 2.0) + across * (md * (3.0 * r * r + wall * wall) / 12.0);
             for s in [-1.0, 1.0] {
@@ -109,6 +117,26 @@ impl Hub {
         })
     }
 
+    /// Free or fixed.
+    pub fn motion(&self) -> HubMotion {
+        self.motion
+    }
+
+    /// Mass, kg.
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// Centre of mass, m.
+    pub fn center_of_mass(&self) -> Vec3 {
+        self.center_of_mass
+    }
+
+    /// Inertia about the centre of mass, kg·m².
+    pub fn inertia(&self) -> Mat3 {
+        self.inertia
+    }
+
     /// Mass properties about the hub's centre of mass.
     pub fn rigid_body(&self) -> RigidBody {
         RigidBody::from_cm(self.mass, Vec3::ZERO, self.inertia)
@@ -116,7 +144,7 @@ impl Hub {
 }
 
 /// Where a component is fixed.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Attachment {
     /// To the hub, at a point of the structure frame.
     Hub {
@@ -125,19 +153,33 @@ pub enum Attachment {
     },
     /// To a section of a beam, `station` metres from the beam's root.
     Beam {
-        /// The parent beam's name.
-        beam: String,
+        /// The parent beam's index in the structure's beam list.
+        beam: usize,
         /// Distance from the parent's root, m, in [0, parent length].
         station: f64,
     },
 }
 
 impl Attachment {
-    /// The parent's name ("hub" or a beam).
-    pub fn parent_name(&self) -> &str {
+    /// Checks the point's or station's range ([`L::COORDINATE`], [`L::STATION`]); the
+    /// parent's existence and length are checked by [`super::Structure::new`].
+    fn validated(self) -> Result<Self, StructureError> {
         match self {
-            Attachment::Hub { .. } => "hub",
-            Attachment::Beam { beam, .. } => beam,
+            Attachment::Hub { point: p } => Ok(Attachment::Hub {
+                point: point(Field::Root, p)?,
+            }),
+            Attachment::Beam { beam, station } => Ok(Attachment::Beam {
+                beam,
+                station: in_range(Field::Station, station, L::STATION)?,
+            }),
+        }
+    }
+
+    /// The parent beam's index (None: the hub).
+    pub fn parent_beam(&self) -> Option<usize> {
+        match self {
+            Attachment::Hub { .. } => None,
+            Attachment::Beam { beam, .. } => Some(*beam),
         }
     }
 }
@@ -160,8 +202,8 @@ pub struct BeamSection {
 impl BeamSection {
     /// A thin- or thick-walled circular tube: A = π(R² − r²), I = π(R⁴ − r⁴)/4, J = I_p = 2I.
     pub fn tube(outer_diameter: f64, wall: f64) -> Result<Self, StructureError> {
-        positive("outer_diameter", outer_diameter)?;
-        positive("wall", wall)?;
+        in_range(Field::OuterDiameter, outer_diameter, L::SECTION)?;
+        in_range(Field::Wall, wall, L::SECTION)?;
         let big_r = outer_diameter / 2.0;
         if wall >= big_r {
             return Err(StructureError::WallTooThick {
@@ -181,7 +223,7 @@ impl BeamSection {
         })
     }
 
-    /// A general section given by its constants (all > 0).
+    /// A general section given by its constants ([`L::AREA`], [`L::SECOND_MOMENT`]).
     pub fn general(
         area: f64,
         iy: f64,
@@ -189,17 +231,12 @@ impl BeamSection {
         torsion_constant: f64,
         polar_inertia: f64,
     ) -> Result<Self, StructureError> {
-        positive("area", area)?;
-        positive("iy", iy)?;
-        positive("iz", iz)?;
-        positive("torsion_constant", torsion_constant)?;
-        positive("polar_inertia", polar_inertia)?;
         Ok(Self {
-            area,
-            iy,
-            iz,
-            torsion_constant,
-            polar_inertia,
+            area: in_range(Field::Area, area, L::AREA)?,
+            iy: in_range(Field::Iy, iy, L::SECOND_MOMENT)?,
+            iz: in_range(Field::Iz, iz, L::SECOND_MOMENT)?,
+            torsion_constant: in_range(Field::TorsionConstant, torsion_constant, L::SECOND_MOMENT)?,
+            polar_inertia: in_range(Field::PolarInertia, polar_inertia, L::SECOND_MOMENT)?,
         })
     }
 }
@@ -218,7 +255,7 @@ pub struct BeamTerms {
 /// Largest number of functions per field.
 pub const MAX_TERMS: usize = 100;
 
-pub(super) fn check_terms(field: &'static str, n: usize) -> Result<usize, StructureError> {
+fn check_terms(field: Field, n: usize) -> Result<usize, StructureError> {
     if n == 0 || n > MAX_TERMS {
         Err(StructureError::Terms { field, value: n })
     } else {
@@ -230,9 +267,9 @@ impl BeamTerms {
     /// Validates 1 ≤ terms ≤ 100 for each field.
     pub fn new(bending: usize, torsion: usize, axial: usize) -> Result<Self, StructureError> {
         Ok(Self {
-            bending: check_terms("bending", bending)?,
-            torsion: check_terms("torsion", torsion)?,
-            axial: check_terms("axial", axial)?,
+            bending: check_terms(Field::TermsBending, bending)?,
+            torsion: check_terms(Field::TermsTorsion, torsion)?,
+            axial: check_terms(Field::TermsAxial, axial)?,
         })
     }
 
@@ -258,11 +295,11 @@ impl Frame {
     /// axis) or, by default, e_y = normalize(Z × e_x) (or X × e_x when the axis is within
     /// ~25° of Z): a deterministic choice, documented in docs/scenario.md.
     pub fn new(axis: Vec3, y_axis: Option<Vec3>) -> Result<Self, StructureError> {
-        let ex = unit("axis", axis)?;
+        let ex = unit(Field::Axis, axis)?;
         let ey = match y_axis {
             Some(y) => {
-                let y = unit("y_axis", y)?;
-                perpendicular("y_axis", ex, y)?;
+                let y = unit(Field::YAxis, y)?;
+                perpendicular(Field::YAxis, ex, y)?;
                 y
             }
             None => {
@@ -284,7 +321,7 @@ impl Frame {
 }
 
 /// Checks that `b` is perpendicular to `a` (both unit) to 1e-6 rad.
-pub(super) fn perpendicular(field: &'static str, a: Vec3, b: Vec3) -> Result<(), StructureError> {
+fn perpendicular(field: Field, a: Vec3, b: Vec3) -> Result<(), StructureError> {
     let c = a.dot(b);
     if c.abs() > 1e-6 {
         return Err(StructureError::NotPerpendicular {
@@ -295,12 +332,26 @@ pub(super) fn perpendicular(field: &'static str, a: Vec3, b: Vec3) -> Result<(),
     Ok(())
 }
 
-/// A straight Euler–Bernoulli beam clamped at its root to its parent (MODEL.md §3.1).
+/// A straight Euler–Bernoulli beam clamped at its root to its parent.
 /// Fields: axial u (along e_x), bending v (along e_y, stiffness EI_z), w (along e_z, EI_y),
 /// torsion θ (about e_x).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Beam {
-    /// Unique name.
+    pub(crate) name: String,
+    pub(crate) attachment: Attachment,
+    pub(crate) frame: Frame,
+    pub(crate) length: f64,
+    pub(crate) youngs_modulus: f64,
+    pub(crate) shear_modulus: f64,
+    pub(crate) density: f64,
+    pub(crate) section: BeamSection,
+    pub(crate) terms: BeamTerms,
+}
+
+/// What a beam is made of, for [`Beam::new`].
+#[derive(Debug, Clone)]
+pub struct BeamSpec {
+    /// Unique name ([`L::valid_name`]).
     pub name: String,
     /// Where the root is clamped.
     pub attachment: Attachment,
@@ -308,12 +359,8 @@ pub struct Beam {
     pub frame: Frame,
     /// Length L, m.
     pub length: f64,
-    /// Young's modulus E, Pa.
-    pub youngs_modulus: f64,
-    /// Shear modulus G, Pa.
-    pub shear_modulus: f64,
-    /// Density ρ, kg/m³.
-    pub density: f64,
+    /// Material.
+    pub material: Material,
     /// Section constants.
     pub section: BeamSection,
     /// Ritz functions per field.
@@ -321,6 +368,66 @@ pub struct Beam {
 }
 
 impl Beam {
+    /// Validates the name, length and attachment.
+    pub fn new(s: BeamSpec) -> Result<Self, StructureError> {
+        Ok(Self {
+            name: name(&s.name)?,
+            attachment: s.attachment.validated()?,
+            frame: s.frame,
+            length: in_range(Field::Length, s.length, L::LENGTH)?,
+            youngs_modulus: s.material.youngs_modulus,
+            shear_modulus: s.material.shear_modulus,
+            density: s.material.density,
+            section: s.section,
+            terms: s.terms,
+        })
+    }
+
+    /// Unique name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Where the root is clamped.
+    pub fn attachment(&self) -> Attachment {
+        self.attachment
+    }
+
+    /// Local frame.
+    pub fn frame(&self) -> Frame {
+        self.frame
+    }
+
+    /// Length L, m.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Young's modulus E, Pa.
+    pub fn youngs_modulus(&self) -> f64 {
+        self.youngs_modulus
+    }
+
+    /// Shear modulus G, Pa.
+    pub fn shear_modulus(&self) -> f64 {
+        self.shear_modulus
+    }
+
+    /// Density ρ, kg/m³.
+    pub fn density(&self) -> f64 {
+        self.density
+    }
+
+    /// Section constants.
+    pub fn section(&self) -> BeamSection {
+        self.section
+    }
+
+    /// Ritz functions per field.
+    pub fn terms(&self) -> BeamTerms {
+        self.terms
+    }
+
     /// Mass per length ρA, kg/m.
     pub fn mass_per_length(&self) -> f64 {
         self.density * self.section.area
@@ -332,7 +439,7 @@ impl Beam {
     }
 
     /// Mass properties about the root: line mass plus ρI_p about the axis (no rotary inertia
-    /// of the section about transverse axes, consistent with the kinetic energy of §3.1).
+    /// of the section about transverse axes, consistent with the beam's kinetic energy).
     pub fn rigid_body(&self) -> RigidBody {
         let m = self.mass();
         let l = self.length;
@@ -360,8 +467,8 @@ impl PlateTerms {
     /// Validates 1 ≤ terms ≤ 100 in each direction.
     pub fn new(length: usize, width: usize) -> Result<Self, StructureError> {
         Ok(Self {
-            length: check_terms("length", length)?,
-            width: check_terms("width", width)?,
+            length: check_terms(Field::TermsLength, length)?,
+            width: check_terms(Field::TermsWidth, width)?,
         })
     }
 
@@ -371,80 +478,160 @@ impl PlateTerms {
     }
 }
 
-/// A rectangular Kirchhoff plate clamped along its root edge to a rigid massless yoke
-/// (MODEL.md §3.1). Local coordinates: x ∈ [0, a] along `length_axis`, y ∈ [−b/2, b/2] along
-/// `width_axis` = normal × length_axis; the root edge's centre is the attachment point.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Plate {
-    /// Unique name.
+/// How a plate's stiffness and mass are given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlateStiffness {
+    /// A homogeneous plate: D = Eh³/12(1 − ν²), μ = ρh.
+    Homogeneous {
+        /// Thickness h, m.
+        thickness: f64,
+        /// Its material.
+        material: Material,
+    },
+    /// Given constants (e.g. a sandwich panel).
+    Given {
+        /// Mass per area μ, kg/m².
+        areal_density: f64,
+        /// Bending stiffness D, N·m.
+        bending_stiffness: f64,
+        /// Poisson's ratio ν.
+        poisson_ratio: f64,
+    },
+}
+
+/// What a plate is made of, for [`Plate::new`].
+#[derive(Debug, Clone)]
+pub struct PlateSpec {
+    /// Unique name ([`L::valid_name`]).
     pub name: String,
     /// Where the yoke is fixed.
     pub attachment: Attachment,
-    /// Unit vector e_a, away from the clamped edge.
+    /// Direction away from the clamped edge (any scale).
     pub length_axis: Vec3,
-    /// Unit normal n.
+    /// Normal (any scale), perpendicular to the length axis.
     pub normal: Vec3,
     /// Length a, m.
     pub length: f64,
     /// Width b, m.
     pub width: f64,
-    /// Mass per area μ = ρh, kg/m².
-    pub areal_density: f64,
-    /// Bending stiffness D = Eh³/12(1 − ν²), N·m.
-    pub bending_stiffness: f64,
-    /// Poisson's ratio ν.
-    pub poisson_ratio: f64,
+    /// Stiffness and mass.
+    pub stiffness: PlateStiffness,
     /// Ritz functions.
     pub terms: PlateTerms,
 }
 
+/// A rectangular Kirchhoff plate clamped along its root edge to a rigid massless yoke.
+/// Local coordinates: x ∈ [0, a] along `length_axis`, y ∈ [−b/2, b/2] along
+/// `width_axis` = normal × length_axis; the root edge's centre is the attachment point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plate {
+    pub(crate) name: String,
+    pub(crate) attachment: Attachment,
+    pub(crate) length_axis: Vec3,
+    pub(crate) normal: Vec3,
+    pub(crate) length: f64,
+    pub(crate) width: f64,
+    pub(crate) areal_density: f64,
+    pub(crate) bending_stiffness: f64,
+    pub(crate) poisson_ratio: f64,
+    pub(crate) terms: PlateTerms,
+}
+
 impl Plate {
-    /// Validates the geometry and stiffness of a plate.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        name: String,
-        attachment: Attachment,
-        length_axis: Vec3,
-        normal: Vec3,
-        length: f64,
-        width: f64,
-        areal_density: f64,
-        bending_stiffness: f64,
-        poisson_ratio: f64,
-        terms: PlateTerms,
-    ) -> Result<Self, StructureError> {
-        let length_axis = unit("length_axis", length_axis)?;
-        let normal = unit("normal", normal)?;
-        perpendicular("normal", length_axis, normal)?;
-        positive("length", length)?;
-        positive("width", width)?;
-        positive("areal_density", areal_density)?;
-        positive("bending_stiffness", bending_stiffness)?;
-        if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
-            return Err(StructureError::PoissonRatio {
-                value: poisson_ratio,
-            });
-        }
+    /// Validates the name, geometry, stiffness and attachment of a plate.
+    pub fn new(s: PlateSpec) -> Result<Self, StructureError> {
+        let length_axis = unit(Field::LengthAxis, s.length_axis)?;
+        let normal = unit(Field::Normal, s.normal)?;
+        perpendicular(Field::Normal, length_axis, normal)?;
+        let (areal_density, bending_stiffness, poisson_ratio) = match s.stiffness {
+            PlateStiffness::Homogeneous {
+                thickness,
+                material,
+            } => {
+                let h = in_range(Field::Thickness, thickness, L::SECTION)?;
+                let nu = material.poisson_ratio;
+                (
+                    material.density * h,
+                    material.youngs_modulus * h.powi(3) / (12.0 * (1.0 - nu * nu)),
+                    nu,
+                )
+            }
+            PlateStiffness::Given {
+                areal_density,
+                bending_stiffness,
+                poisson_ratio,
+            } => (
+                in_range(Field::ArealDensity, areal_density, L::AREAL_DENSITY)?,
+                in_range(
+                    Field::BendingStiffness,
+                    bending_stiffness,
+                    L::BENDING_STIFFNESS,
+                )?,
+                in_range(Field::PoissonRatio, poisson_ratio, L::POISSON)?,
+            ),
+        };
         Ok(Self {
-            name,
-            attachment,
+            name: name(&s.name)?,
+            attachment: s.attachment.validated()?,
             length_axis,
             normal,
-            length,
-            width,
+            length: in_range(Field::Length, s.length, L::LENGTH)?,
+            width: in_range(Field::Width, s.width, L::LENGTH)?,
             areal_density,
             bending_stiffness,
             poisson_ratio,
-            terms,
+            terms: s.terms,
         })
     }
 
-    /// D = Eh³/12(1 − ν²) and μ = ρh of a homogeneous plate of thickness h.
-    pub fn homogeneous_properties(thickness: f64, e: f64, nu: f64, rho: f64) -> (f64, f64) {
-        (
-            e * thickness.powi(3) / (12.0 * (1.0 - nu * nu)),
-            rho * thickness,
-        )
+    /// Unique name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Where the yoke is fixed.
+    pub fn attachment(&self) -> Attachment {
+        self.attachment
+    }
+
+    /// Unit vector e_a, away from the clamped edge.
+    pub fn length_axis(&self) -> Vec3 {
+        self.length_axis
+    }
+
+    /// Unit normal n.
+    pub fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    /// Length a, m.
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Width b, m.
+    pub fn width(&self) -> f64 {
+        self.width
+    }
+
+    /// Mass per area μ = ρh, kg/m².
+    pub fn areal_density(&self) -> f64 {
+        self.areal_density
+    }
+
+    /// Bending stiffness D, N·m.
+    pub fn bending_stiffness(&self) -> f64 {
+        self.bending_stiffness
+    }
+
+    /// Poisson's ratio ν.
+    pub fn poisson_ratio(&self) -> f64 {
+        self.poisson_ratio
+    }
+
+    /// Ritz functions.
+    pub fn terms(&self) -> PlateTerms {
+        self.terms
     }
 
     /// Width direction e_b = n × e_a.
@@ -476,19 +663,57 @@ impl Plate {
 /// the attachment point (rigid arm).
 #[derive(Debug, Clone, PartialEq)]
 pub struct LumpedMass {
-    /// Unique name.
-    pub name: String,
-    /// Where it is fixed.
-    pub attachment: Attachment,
-    /// Centre of mass relative to the attachment point, m.
-    pub offset: Vec3,
-    /// Mass, kg.
-    pub mass: f64,
-    /// Inertia about its centre of mass, kg·m².
-    pub inertia: Mat3,
+    pub(crate) name: String,
+    pub(crate) attachment: Attachment,
+    pub(crate) offset: Vec3,
+    pub(crate) mass: f64,
+    pub(crate) inertia: Mat3,
 }
 
 impl LumpedMass {
+    /// Validates the name, attachment, offset and mass; `inertia` about the centre of mass
+    /// (from [`super::inertia_tensor`]; zero for a point mass).
+    pub fn new(
+        name_: &str,
+        attachment: Attachment,
+        offset: Vec3,
+        mass: f64,
+        inertia: Mat3,
+    ) -> Result<Self, StructureError> {
+        Ok(Self {
+            name: name(name_)?,
+            attachment: attachment.validated()?,
+            offset: point(Field::Offset, offset)?,
+            mass: in_range(Field::Mass, mass, L::MASS)?,
+            inertia,
+        })
+    }
+
+    /// Unique name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Where it is fixed.
+    pub fn attachment(&self) -> Attachment {
+        self.attachment
+    }
+
+    /// Centre of mass relative to the attachment point, m.
+    pub fn offset(&self) -> Vec3 {
+        self.offset
+    }
+
+    /// Mass, kg.
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// Inertia about its centre of mass, kg·m².
+    pub fn inertia(&self) -> Mat3 {
+        self.inertia
+    }
+
     /// Mass properties about the attachment point.
     pub fn rigid_body(&self) -> RigidBody {
         RigidBody::from_cm(self.mass, self.offset, self.inertia)

@@ -1,6 +1,7 @@
 //! Isotropic linear-elastic materials.
 
-use super::StructureError;
+use super::{in_range, Field, StructureError};
+use crate::limits as L;
 
 /// An isotropic material (SI units).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -16,22 +17,29 @@ pub struct Material {
 }
 
 impl Material {
-    /// Validates E > 0, ρ > 0, −1 < ν < 0.5 and G > 0 (default E/(2(1+ν))).
+    /// Validates E and G in [`L::MODULUS`] (G defaults to E/(2(1+ν))), ρ in [`L::DENSITY`]
+    /// and −1 < ν < 0.5.
+    ///
+    /// ```
+    /// use flexcraft::structure::{Field, Material, StructureError};
+    /// let al = Material::new(70e9, 0.3, 2700.0, None).unwrap();
+    /// assert!((al.shear_modulus - 70e9 / 2.6).abs() < 1.0);
+    /// let e = Material::new(70e9, 0.5, 2700.0, None).unwrap_err();
+    /// assert_eq!(e.field(), Field::PoissonRatio);
+    /// ```
     pub fn new(
         youngs_modulus: f64,
         poisson_ratio: f64,
         density: f64,
         shear_modulus: Option<f64>,
     ) -> Result<Self, StructureError> {
-        super::positive("youngs_modulus", youngs_modulus)?;
-        super::positive("density", density)?;
-        if !(poisson_ratio.is_finite() && poisson_ratio > -1.0 && poisson_ratio < 0.5) {
-            return Err(StructureError::PoissonRatio {
-                value: poisson_ratio,
-            });
-        }
-        let shear_modulus = shear_modulus.unwrap_or(youngs_modulus / (2.0 * (1.0 + poisson_ratio)));
-        super::positive("shear_modulus", shear_modulus)?;
+        in_range(Field::YoungsModulus, youngs_modulus, L::MODULUS)?;
+        in_range(Field::PoissonRatio, poisson_ratio, L::POISSON)?;
+        in_range(Field::Density, density, L::DENSITY)?;
+        let shear_modulus = match shear_modulus {
+            Some(g) => in_range(Field::ShearModulus, g, L::MODULUS)?,
+            None => youngs_modulus / (2.0 * (1.0 + poisson_ratio)),
+        };
         Ok(Self {
             youngs_modulus,
             poisson_ratio,

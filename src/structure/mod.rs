@@ -1,153 +1,21 @@
 //! The deployed spacecraft as a tree of components rooted at the hub (MODEL.md §3.1).
 
 pub mod components;
+mod error;
 pub mod material;
 pub mod rigid;
 
 pub use components::{
-    Attachment, Beam, BeamSection, BeamTerms, Frame, Hub, HubMotion, LumpedMass, Plate, PlateTerms,
-    MAX_TERMS,
+    Attachment, Beam, BeamSection, BeamSpec, BeamTerms, Cylinder, Frame, Hub, HubMotion,
+    LumpedMass, Plate, PlateSpec, PlateStiffness, PlateTerms, MAX_TERMS,
 };
+pub(crate) use error::{in_range, name, point, unit};
+pub use error::{Field, StructureError};
 pub use material::Material;
 pub use rigid::{inertia_tensor, RigidBody};
 
 use crate::basis::BasisKind;
 use crate::math::Vec3;
-use thiserror::Error;
-
-/// Why a structure (or one of its parts) is refused.
-#[derive(Debug, Clone, PartialEq, Error)]
-pub enum StructureError {
-    /// A size, mass or modulus that must be positive is not.
-    #[error("{field} must be a positive finite number, got {value}")]
-    NotPositive {
-        /// The quantity.
-        field: &'static str,
-        /// Its value.
-        value: f64,
-    },
-    /// A value is NaN or infinite.
-    #[error("{field} must be finite")]
-    NotFinite {
-        /// The quantity.
-        field: &'static str,
-    },
-    /// ν outside (−1, 0.5).
-    #[error("Poisson's ratio must lie in (-1, 0.5), got {value}")]
-    PoissonRatio {
-        /// The value given.
-        value: f64,
-    },
-    /// A tube wall at least as thick as the tube's radius.
-    #[error("wall thickness {wall} m is not less than the radius {radius} m")]
-    WallTooThick {
-        /// Wall, m.
-        wall: f64,
-        /// Outer radius (or half length for end caps), m.
-        radius: f64,
-    },
-    /// An inertia given with neither 3 nor 6 values.
-    #[error("inertia needs 3 principal values or 6 [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], got {len}")]
-    InertiaLength {
-        /// Number given.
-        len: usize,
-    },
-    /// An inertia tensor that is not positive definite.
-    #[error("inertia tensor is not positive definite: principal moments {principal:?} kg·m²")]
-    InertiaNotPositive {
-        /// Principal moments, ascending.
-        principal: [f64; 3],
-    },
-    /// Principal moments violating I_a + I_b ≥ I_c.
-    #[error("principal moments {principal:?} kg·m² violate the triangle inequality I1 + I2 >= I3")]
-    InertiaTriangle {
-        /// Principal moments, ascending.
-        principal: [f64; 3],
-    },
-    /// A direction vector of (near) zero length.
-    #[error("{field} has zero length")]
-    ZeroAxis {
-        /// The vector.
-        field: &'static str,
-    },
-    /// Two directions that must be perpendicular are not.
-    #[error(
-        "{field} must be perpendicular to the axis; the angle between them is {angle_deg:.6}°"
-    )]
-    NotPerpendicular {
-        /// The vector.
-        field: &'static str,
-        /// Angle, degrees.
-        angle_deg: f64,
-    },
-    /// terms = 0 or > 100.
-    #[error("terms.{field} must be between 1 and 100, got {value}")]
-    Terms {
-        /// The field.
-        field: &'static str,
-        /// Value given.
-        value: usize,
-    },
-    /// Two components with one name.
-    #[error("the name \"{name}\" is used twice")]
-    DuplicateName {
-        /// The name.
-        name: String,
-    },
-    /// A parent that is neither "hub" nor a beam.
-    #[error("{component}: unknown parent \"{parent}\" (the hub is \"hub\"; beams: {known})")]
-    UnknownParent {
-        /// The child.
-        component: String,
-        /// The parent named.
-        parent: String,
-        /// The beams that exist.
-        known: String,
-    },
-    /// Beams whose parents form a loop.
-    #[error("beams form a cycle: {}", path.join(" -> "))]
-    Cycle {
-        /// The loop, first name repeated at the end.
-        path: Vec<String>,
-    },
-    /// A station outside [0, L] of its parent beam.
-    #[error("{component}: station {station_m} m is beyond the parent \"{parent}\" of length {length_m} m")]
-    StationBeyondParent {
-        /// The child.
-        component: String,
-        /// The parent.
-        parent: String,
-        /// The station, m.
-        station_m: f64,
-        /// The parent's length, m.
-        length_m: f64,
-    },
-}
-
-pub(crate) fn positive(field: &'static str, value: f64) -> Result<f64, StructureError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
-    } else {
-        Err(StructureError::NotPositive { field, value })
-    }
-}
-
-pub(crate) fn finite_vec(field: &'static str, v: Vec3) -> Result<Vec3, StructureError> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(StructureError::NotFinite { field })
-    }
-}
-
-pub(crate) fn unit(field: &'static str, v: Vec3) -> Result<Vec3, StructureError> {
-    finite_vec(field, v)?;
-    // A direction of any scale is accepted; only the zero vector has none.
-    if v.0.iter().all(|x| *x == 0.0) {
-        return Err(StructureError::ZeroAxis { field });
-    }
-    Ok(v.normalized())
-}
 
 /// Reference to a component of the structure.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -163,14 +31,27 @@ pub enum ComponentId {
 }
 
 /// A validated structure: the hub, the elastic components and lumped masses, with the
-/// attachment tree checked (known parents, no cycle, stations on their parents).
+/// attachment tree checked (parents exist, no cycle, stations on their parents). Built once
+/// by [`Structure::new`] and read through accessors: nothing can break the tree afterwards.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Structure {
+    pub(crate) name: String,
+    pub(crate) hub: Hub,
+    pub(crate) beams: Vec<Beam>,
+    pub(crate) plates: Vec<Plate>,
+    pub(crate) masses: Vec<LumpedMass>,
+    pub(crate) basis: BasisKind,
+    beam_order: Vec<usize>,
+}
+
+/// Everything a structure is made of, for [`Structure::new`].
+#[derive(Debug, Clone)]
+pub struct Parts {
     /// Name (free text).
     pub name: String,
     /// The hub.
     pub hub: Hub,
-    /// Beams in the order given.
+    /// Beams; attachments refer to beams by their index in this list.
     pub beams: Vec<Beam>,
     /// Plates.
     pub plates: Vec<Plate>,
@@ -178,82 +59,88 @@ pub struct Structure {
     pub masses: Vec<LumpedMass>,
     /// Ritz basis.
     pub basis: BasisKind,
-    beam_order: Vec<usize>,
-    beam_parent: Vec<Option<usize>>,
 }
 
 impl Structure {
-    /// Checks the attachment tree and builds the structure.
-    pub fn new(
-        name: String,
-        hub: Hub,
-        beams: Vec<Beam>,
-        plates: Vec<Plate>,
-        masses: Vec<LumpedMass>,
-        basis: BasisKind,
-    ) -> Result<Self, StructureError> {
+    /// Checks the attachment tree (unique names, parents that exist, no cycle, stations on
+    /// their parents) and builds the structure.
+    ///
+    /// ```
+    /// use flexcraft::math::Vec3;
+    /// use flexcraft::structure::*;
+    /// let aluminium = Material::new(70e9, 0.3, 2700.0, None)?;
+    /// let hub = Hub::new(HubMotion::Fixed, 100.0, Vec3::ZERO, inertia_tensor(&[10.0, 10.0, 10.0])?)?;
+    /// let mast = Beam::new(BeamSpec {
+    ///     name: "mast".into(),
+    ///     attachment: Attachment::Hub { point: Vec3::ZERO },
+    ///     frame: Frame::new(Vec3([1.0, 0.0, 0.0]), None)?,
+    ///     length: 2.0,
+    ///     material: aluminium,
+    ///     section: BeamSection::tube(0.05, 0.002)?,
+    ///     terms: BeamTerms::new(8, 6, 4)?,
+    /// })?;
+    /// let s = Structure::new(Parts {
+    ///     name: "cantilever".into(),
+    ///     hub,
+    ///     beams: vec![mast],
+    ///     plates: vec![],
+    ///     masses: vec![],
+    ///     basis: flexcraft::basis::BasisKind::Legendre,
+    /// })?;
+    /// assert!((s.total_mass() - 100.0 - s.beams()[0].mass()).abs() < 1e-9);
+    /// # Ok::<(), flexcraft::structure::StructureError>(())
+    /// ```
+    pub fn new(parts: Parts) -> Result<Self, StructureError> {
+        let Parts {
+            name,
+            hub,
+            beams,
+            plates,
+            masses,
+            basis,
+        } = parts;
         let mut seen = std::collections::BTreeSet::new();
         seen.insert("hub".to_string());
-        let names = beams
-            .iter()
-            .map(|b| &b.name)
-            .chain(plates.iter().map(|p| &p.name))
-            .chain(masses.iter().map(|m| &m.name));
-        for n in names {
+        let names = (beams.iter().enumerate())
+            .map(|(i, b)| (ComponentId::Beam(i), &b.name))
+            .chain((plates.iter().enumerate()).map(|(i, p)| (ComponentId::Plate(i), &p.name)))
+            .chain((masses.iter().enumerate()).map(|(i, m)| (ComponentId::Mass(i), &m.name)));
+        for (component, n) in names {
             if !seen.insert(n.clone()) {
-                return Err(StructureError::DuplicateName { name: n.clone() });
+                return Err(StructureError::DuplicateName {
+                    component,
+                    name: n.clone(),
+                });
             }
         }
-        let known = beams
-            .iter()
-            .map(|b| b.name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ");
-        let resolve = |component: &str,
-                       att: &Attachment|
-         -> Result<Option<usize>, StructureError> {
-            match att {
-                Attachment::Hub { point } => {
-                    finite_vec("root", *point)?;
-                    Ok(None)
-                }
-                Attachment::Beam { beam, station } => {
-                    let idx = beams.iter().position(|b| &b.name == beam).ok_or_else(|| {
-                        StructureError::UnknownParent {
-                            component: component.to_string(),
-                            parent: beam.clone(),
-                            known: if known.is_empty() {
-                                "none".into()
-                            } else {
-                                known.clone()
-                            },
-                        }
-                    })?;
-                    let len = beams[idx].length;
-                    if !(station.is_finite() && *station >= 0.0 && *station <= len * (1.0 + 1e-12))
-                    {
-                        return Err(StructureError::StationBeyondParent {
-                            component: component.to_string(),
-                            parent: beam.clone(),
-                            station_m: *station,
-                            length_m: len,
-                        });
-                    }
-                    Ok(Some(idx))
+        let check = |component: ComponentId, att: &Attachment| -> Result<(), StructureError> {
+            if let Attachment::Beam { beam, station } = att {
+                let parent = beams.get(*beam).ok_or(StructureError::UnknownParent {
+                    component,
+                    parent: *beam,
+                    count: beams.len(),
+                })?;
+                if *station > parent.length * (1.0 + 1e-12) {
+                    return Err(StructureError::StationBeyondParent {
+                        component,
+                        parent: parent.name.clone(),
+                        station_m: *station,
+                        length_m: parent.length,
+                    });
                 }
             }
+            Ok(())
         };
-        let beam_parent = beams
-            .iter()
-            .map(|b| resolve(&b.name, &b.attachment))
-            .collect::<Result<Vec<_>, _>>()?;
-        for p in &plates {
-            resolve(&p.name, &p.attachment)?;
+        for (i, b) in beams.iter().enumerate() {
+            check(ComponentId::Beam(i), &b.attachment)?;
         }
-        for m in &masses {
-            resolve(&m.name, &m.attachment)?;
+        for (i, p) in plates.iter().enumerate() {
+            check(ComponentId::Plate(i), &p.attachment)?;
         }
-        let beam_order = topological_order(&beams, &beam_parent)?;
+        for (i, m) in masses.iter().enumerate() {
+            check(ComponentId::Mass(i), &m.attachment)?;
+        }
+        let beam_order = topological_order(&beams)?;
         Ok(Self {
             name,
             hub,
@@ -262,8 +149,37 @@ impl Structure {
             masses,
             basis,
             beam_order,
-            beam_parent,
         })
+    }
+
+    /// The structure's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The hub.
+    pub fn hub(&self) -> &Hub {
+        &self.hub
+    }
+
+    /// The beams, in the order given.
+    pub fn beams(&self) -> &[Beam] {
+        &self.beams
+    }
+
+    /// The plates.
+    pub fn plates(&self) -> &[Plate] {
+        &self.plates
+    }
+
+    /// The lumped masses.
+    pub fn masses(&self) -> &[LumpedMass] {
+        &self.masses
+    }
+
+    /// The Ritz basis.
+    pub fn basis(&self) -> BasisKind {
+        self.basis
     }
 
     /// Beam indices with every parent before its children.
@@ -273,7 +189,7 @@ impl Structure {
 
     /// The parent beam of beam i (None: the hub).
     pub fn beam_parent(&self, i: usize) -> Option<usize> {
-        self.beam_parent[i]
+        self.beams[i].attachment.parent_beam()
     }
 
     /// Index of the beam named `name`.
@@ -281,13 +197,20 @@ impl Structure {
         self.beams.iter().position(|b| b.name == name)
     }
 
+    /// The name of an attachment's parent ("hub" or the beam's).
+    pub fn parent_name(&self, att: &Attachment) -> &str {
+        match att.parent_beam() {
+            None => "hub",
+            Some(i) => &self.beams[i].name,
+        }
+    }
+
     /// Structure-frame position of an attachment.
     pub fn attachment_point(&self, att: &Attachment) -> Vec3 {
         match att {
             Attachment::Hub { point } => *point,
             Attachment::Beam { beam, station } => {
-                let i = self.beam_index(beam).unwrap_or(0);
-                self.beam_root(i) + self.beams[i].frame.ex * *station
+                self.beam_root(*beam) + self.beams[*beam].frame.ex * *station
             }
         }
     }
@@ -329,10 +252,7 @@ impl Structure {
     }
 }
 
-fn topological_order(
-    beams: &[Beam],
-    parent: &[Option<usize>],
-) -> Result<Vec<usize>, StructureError> {
+fn topological_order(beams: &[Beam]) -> Result<Vec<usize>, StructureError> {
     // 0 = unvisited, 1 = on the current path, 2 = done.
     let mut state = vec![0u8; beams.len()];
     let mut order = Vec::with_capacity(beams.len());
@@ -349,12 +269,15 @@ fn topological_order(
                         .map(|&p: &usize| beams[p].name.clone())
                         .collect();
                     names.push(beams[i].name.clone());
-                    return Err(StructureError::Cycle { path: names });
+                    return Err(StructureError::Cycle {
+                        component: ComponentId::Beam(path[from]),
+                        path: names,
+                    });
                 }
                 _ => {
                     state[i] = 1;
                     path.push(i);
-                    cur = parent[i];
+                    cur = beams[i].attachment.parent_beam();
                 }
             }
         }

@@ -87,8 +87,17 @@ pub fn inertia_tensor(values: &[f64]) -> Result<Mat3, StructureError> {
         ]),
         n => return Err(StructureError::InertiaLength { len: n }),
     };
-    if values.iter().any(|v| !v.is_finite()) {
-        return Err(StructureError::NotFinite { field: "inertia" });
+    // Ranges (crate::limits): moments in [MIN_PRINCIPAL_INERTIA, INERTIA.hi], products in
+    // INERTIA; non-finite values are outside both.
+    for (i, v) in values.iter().enumerate() {
+        let ok = crate::limits::INERTIA.contains(*v)
+            && (i >= 3 || v.abs() >= crate::limits::MIN_PRINCIPAL_INERTIA);
+        if !ok {
+            return Err(StructureError::InertiaEntry {
+                entry: i + 1,
+                value: *v,
+            });
+        }
     }
     let (p, _) = j.symmetric_eigen();
     if p[0] <= 0.0 {

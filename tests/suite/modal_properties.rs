@@ -43,7 +43,7 @@ fn rigid_block_reproduces_total_mass_centre_of_mass_and_inertia() {
         let st = &model.structure;
         // The hub's coordinates are the translation of, and rotation about, its centre of
         // mass: the rigid part of M is the whole structure's 6×6 mass block about that point.
-        let body = st.rigid_body().about(st.hub.center_of_mass);
+        let body = st.rigid_body().about(st.hub().center_of_mass());
         let block = body.block();
         let scale = block.iter().flatten().fold(0.0_f64, |a, v| a.max(v.abs()));
         for (i, row) in block.iter().enumerate() {

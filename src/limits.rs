@@ -1,4 +1,6 @@
-//! The accepted range of every numeric scenario key (docs/scenario.md lists them).
+//! The accepted range of every physical quantity a model takes (docs/scenario.md lists
+//! them per scenario key). The domain constructors (`structure`, `deploy`, `response`) are
+//! the only places that check them.
 //!
 //! The ranges are physical (no spacecraft has a 1e308 kg hub) and keep the arithmetic of the
 //! Ritz assembly, the eigen-solve and the deployment integration finite and well inside the
@@ -13,8 +15,10 @@ pub struct Limit {
     pub lo: f64,
     /// Largest accepted value.
     pub hi: f64,
-    /// The lower bound itself is refused (e.g. a length must be > 0).
+    /// The lower bound itself is refused.
     pub open_lo: bool,
+    /// The upper bound itself is refused.
+    pub open_hi: bool,
     /// Unit for messages.
     pub unit: &'static str,
 }
@@ -24,15 +28,27 @@ const fn closed(lo: f64, hi: f64, unit: &'static str) -> Limit {
         lo,
         hi,
         open_lo: false,
+        open_hi: false,
         unit,
     }
 }
 
-const fn above(lo: f64, hi: f64, unit: &'static str) -> Limit {
+const fn open(lo: f64, hi: f64, unit: &'static str) -> Limit {
     Limit {
         lo,
         hi,
         open_lo: true,
+        open_hi: true,
+        unit,
+    }
+}
+
+const fn closed_open(lo: f64, hi: f64, unit: &'static str) -> Limit {
+    Limit {
+        lo,
+        hi,
+        open_lo: false,
+        open_hi: true,
         unit,
     }
 }
@@ -40,13 +56,32 @@ const fn above(lo: f64, hi: f64, unit: &'static str) -> Limit {
 impl Limit {
     /// Whether `v` is finite and inside the interval.
     pub fn contains(&self, v: f64) -> bool {
-        v.is_finite()
-            && v <= self.hi
-            && if self.open_lo {
-                v > self.lo
-            } else {
-                v >= self.lo
-            }
+        let below_hi = if self.open_hi {
+            v < self.hi
+        } else {
+            v <= self.hi
+        };
+        let above_lo = if self.open_lo {
+            v > self.lo
+        } else {
+            v >= self.lo
+        };
+        v.is_finite() && below_hi && above_lo
+    }
+
+    /// Whether every value inside is positive (for messages: "must be a positive …").
+    pub fn positive(&self) -> bool {
+        self.lo > 0.0 || (self.open_lo && self.lo == 0.0)
+    }
+
+    /// The message for a refused value: "must be a positive finite number in [1e-3, 1e4] m,
+    /// got -1e0".
+    pub fn refusal(&self, v: f64) -> String {
+        format!(
+            "must be a {}finite number in {}, got {v:e}",
+            if self.positive() { "positive " } else { "" },
+            self.describe()
+        )
     }
 
     /// "[1e-3, 1e4] m", for messages and docs.
@@ -57,10 +92,11 @@ impl Limit {
             format!(" {}", self.unit)
         };
         format!(
-            "{}{}, {}]{unit}",
+            "{}{}, {}{}{unit}",
             if self.open_lo { "(" } else { "[" },
             fmt_bound(self.lo),
-            fmt_bound(self.hi)
+            fmt_bound(self.hi),
+            if self.open_hi { ")" } else { "]" }
         )
     }
 }
@@ -85,8 +121,8 @@ pub const STATION: Limit = closed(0.0, 1e4, "m");
 pub const MODULUS: Limit = closed(1e3, 1e13, "Pa");
 /// Material density.
 pub const DENSITY: Limit = closed(1e-3, 1e5, "kg/m³");
-/// Poisson's ratio: (−1, 0.5) exclusive at both ends (checked by [`crate::structure`]).
-pub const POISSON: Limit = above(-1.0, 0.5, "");
+/// Poisson's ratio: (−1, 0.5), both ends excluded.
+pub const POISSON: Limit = open(-1.0, 0.5, "");
 /// Masses: hub, lumped masses, panels.
 pub const MASS: Limit = closed(1e-6, 1e9, "kg");
 /// Any entry of an inertia tensor, in magnitude (kg·m²); principal moments are also checked
@@ -128,9 +164,8 @@ pub const MAX_PANELS: usize = 100;
 pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
 /// Deployment end time and response duration.
 pub const DURATION: Limit = closed(1e-6, 1e6, "s");
-/// Modal damping ratio of the response, [0, 1): an underdamped structure (1 itself is
-/// refused by the scenario layer).
-pub const DAMPING_RATIO: Limit = closed(0.0, 1.0, "");
+/// Modal damping ratio of the response, [0, 1): an underdamped structure.
+pub const DAMPING_RATIO: Limit = closed_open(0.0, 1.0, "");
 /// Output sample rates.
 pub const OUTPUT_RATE: Limit = closed(1e-3, 1e5, "Hz");
 
@@ -201,7 +236,9 @@ mod tests {
         assert!(!MASS.contains(5e-324));
         assert_eq!(LENGTH.describe(), "[1e-3, 1e4] m");
         assert_eq!(DURATION.describe(), "[1e-6, 1e6] s");
-        assert_eq!(POISSON.describe(), "(-1, 0.5]");
+        assert_eq!(POISSON.describe(), "(-1, 0.5)");
+        assert!(!POISSON.contains(0.5) && !POISSON.contains(-1.0));
+        assert!(!DAMPING_RATIO.contains(1.0) && DAMPING_RATIO.contains(0.0));
     }
 
     #[test]

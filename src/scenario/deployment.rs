@@ -1,0 +1,306 @@
+//! `[deployment]`: the accordion-folded array of one plate, its hinges and the run settings.
+//! The chain itself (panel masses, the hub's planar mass properties, the root arm) is derived
+//! from the structure by [`crate::deploy::planar`].
+
+use super::context::Ctx;
+use super::raw::{RawDeployment, RawLatching, RawMotion, S};
+use super::ScenarioError;
+use crate::deploy::chain::Hinge;
+use crate::deploy::{Deployment, Latching};
+use crate::limits as L;
+use crate::structure::Structure;
+
+/// Default deployment settings (docs/scenario.md).
+pub const DEFAULT_END_TIME: f64 = 300.0;
+/// Default sample rate, Hz.
+pub const DEFAULT_OUTPUT_RATE: f64 = 10.0;
+/// Default relative integration tolerance.
+pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+
+/// Builds the deployment chain from `[deployment]` and the structure (MODEL.md §3.2).
+pub(super) fn lower(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+    st: &Structure,
+) -> Result<Deployment, ScenarioError> {
+    use std::f64::consts::PI;
+    let d = raw.get_ref();
+    let plate_index = st
+        .plates
+        .iter()
+        .position(|p| p.name == *d.plate.get_ref())
+        .ok_or_else(|| {
+            let names: Vec<&str> = st.plates.iter().map(|p| p.name.as_str()).collect();
+            cx.invalid(
+                d.plate.span(),
+                "deployment.plate",
+                format!(
+                    "no plate named \"{}\" (plates: {})",
+                    d.plate.get_ref(),
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            )
+        })?;
+    let plate = &st.plates[plate_index];
+    let lengths: Vec<f64> = match (&d.panels, &d.panel_lengths) {
+        (Some(_), Some(l)) => {
+            return Err(cx.invalid(
+                l.span(),
+                "deployment.panel_lengths",
+                "give either panels or panel_lengths, not both",
+            ))
+        }
+        (Some(n), None) => {
+            let v = *n.get_ref();
+            if !(1..=L::MAX_PANELS as i64).contains(&v) {
+                return Err(cx.invalid(
+                    n.span(),
+                    "deployment.panels",
+                    format!("must be between 1 and {}, got {v}", L::MAX_PANELS),
+                ));
+            }
+            vec![plate.length / v as f64; v as usize]
+        }
+        (None, Some(l)) => {
+            let v = l.get_ref();
+            if v.is_empty() || v.len() > L::MAX_PANELS {
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!("needs 1 to {} lengths, got {}", L::MAX_PANELS, v.len()),
+                ));
+            }
+            if let Some(bad) = v.iter().find(|x| !L::PANEL_LENGTH.contains(**x)) {
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!(
+                        "every length must lie in {}, got {bad:e}",
+                        L::PANEL_LENGTH.describe()
+                    ),
+                ));
+            }
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::INFINITY, 0.0_f64), |(a, b), x| (a.min(*x), b.max(*x)));
+            if hi > L::MAX_PANEL_LENGTH_RATIO * lo {
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!(
+                        "the longest panel ({hi} m) is more than {} times the shortest ({lo} m)",
+                        L::MAX_PANEL_LENGTH_RATIO
+                    ),
+                ));
+            }
+            let sum: f64 = v.iter().sum();
+            if (sum - plate.length).abs() > 1e-9 * plate.length {
+                return Err(cx.invalid(
+                    l.span(),
+                    "deployment.panel_lengths",
+                    format!(
+                        "the lengths sum to {sum} m, but the plate \"{}\" is {} m long",
+                        plate.name, plate.length
+                    ),
+                ));
+            }
+            v.clone()
+        }
+        (None, None) => {
+            return Err(cx.invalid(
+                raw.span(),
+                "deployment.panels",
+                "missing: give panels or panel_lengths",
+            ))
+        }
+    };
+    let n = lengths.len();
+    let panel_mass = match &d.panel_mass {
+        Some(m) => Some(cx.bounded(m, "deployment.panel_mass", L::MASS)?),
+        None => None,
+    };
+    let panel_inertia = match &d.panel_inertia {
+        Some(m) => Some(cx.bounded(m, "deployment.panel_inertia", L::PANEL_INERTIA)?),
+        None => None,
+    };
+    // Hinges: [deployment.hinge] for all, [[deployment.hinges]] per hinge overriding it.
+    let all = d.hinge.as_ref().map(|h| h.get_ref());
+    let k_all = match all.and_then(|h| h.stiffness.as_ref()) {
+        Some(k) => Some(cx.bounded(k, "deployment.hinge.stiffness", L::HINGE_STIFFNESS)?),
+        None => None,
+    };
+    let preload = cx.bounded_or(
+        &all.and_then(|h| h.preload_angle.clone()),
+        0.0,
+        "deployment.hinge.preload_angle",
+        L::ANGLE,
+    )?;
+    let damping_all = cx.bounded_or(
+        &all.and_then(|h| h.damping.clone()),
+        0.0,
+        "deployment.hinge.damping",
+        L::HINGE_DAMPING,
+    )?;
+    let friction_all = cx.bounded_or(
+        &all.and_then(|h| h.friction.clone()),
+        0.0,
+        "deployment.hinge.friction",
+        L::HINGE_FRICTION,
+    )?;
+    if let Some(list) = &d.hinges {
+        if list.len() != n {
+            let span = list.first().map_or(raw.span(), |h| h.span());
+            return Err(cx.invalid(
+                span,
+                "deployment.hinges",
+                format!("{} entries for {n} panels: give one per hinge", list.len()),
+            ));
+        }
+    }
+    let mut hinges = Vec::with_capacity(n);
+    for i in 0..n {
+        let one = d.hinges.as_ref().map(|l| &l[i]);
+        let r = one.map(|h| h.get_ref());
+        let key = |f: &str| {
+            if r.is_some() {
+                format!("deployment.hinges[{i}].{f}")
+            } else {
+                format!("deployment.hinge.{f}")
+            }
+        };
+        let default_latch = if i == 0 { PI / 2.0 } else { PI };
+        let latch = cx.bounded_or(
+            &r.and_then(|h| h.latch_angle.clone()),
+            default_latch,
+            key("latch_angle"),
+            L::ANGLE,
+        )?;
+        if !(latch > 0.0 && latch <= PI) {
+            let span = r
+                .and_then(|h| h.latch_angle.as_ref())
+                .map_or(raw.span(), |x| x.span());
+            return Err(cx.invalid(
+                span,
+                key("latch_angle"),
+                format!("must lie in (0, π], got {latch}"),
+            ));
+        }
+        let stiffness = match r.and_then(|h| h.stiffness.clone()) {
+            Some(k) => cx.bounded(&k, key("stiffness"), L::HINGE_STIFFNESS)?,
+            None => k_all.ok_or_else(|| {
+                cx.invalid(
+                    one.map_or(raw.span(), |h| h.span()),
+                    "deployment.hinge.stiffness",
+                    format!("missing: hinge {} has no stiffness (set [deployment.hinge] stiffness or one per hinge)", i + 1),
+                )
+            })?,
+        };
+        let reference = cx.bounded_or(
+            &r.and_then(|h| h.reference_angle.clone()),
+            latch + preload,
+            key("reference_angle"),
+            L::ANGLE,
+        )?;
+        let initial = cx.bounded_or(
+            &r.and_then(|h| h.initial_angle.clone()),
+            0.0,
+            key("initial_angle"),
+            L::ANGLE,
+        )?;
+        if initial >= latch {
+            let span = r
+                .and_then(|h| h.initial_angle.as_ref())
+                .map_or(raw.span(), |x| x.span());
+            return Err(cx.invalid(
+                span,
+                key("initial_angle"),
+                format!("{initial} rad is not below the latch angle {latch} rad"),
+            ));
+        }
+        hinges.push(Hinge {
+            stiffness,
+            reference_angle: reference,
+            damping: cx.bounded_or(
+                &r.and_then(|h| h.damping.clone()),
+                damping_all,
+                key("damping"),
+                L::HINGE_DAMPING,
+            )?,
+            friction: cx.bounded_or(
+                &r.and_then(|h| h.friction.clone()),
+                friction_all,
+                key("friction"),
+                L::HINGE_FRICTION,
+            )?,
+            latch_angle: latch,
+            initial_angle: initial,
+            initial_rate: cx.bounded_or(
+                &r.and_then(|h| h.initial_rate.clone()),
+                0.0,
+                key("initial_rate"),
+                L::RATE,
+            )?,
+        });
+    }
+    let chain = crate::deploy::planar::chain_of_plate(
+        st,
+        plate_index,
+        &lengths,
+        crate::deploy::planar::PanelOverrides {
+            mass: panel_mass,
+            inertia: panel_inertia,
+        },
+        hinges,
+        matches!(d.hub.as_ref().map(|h| *h.get_ref()), Some(RawMotion::Free)),
+    );
+    let tolerance = cx.bounded_or(
+        &d.tolerance,
+        DEFAULT_TOLERANCE,
+        "deployment.tolerance",
+        L::TOLERANCE,
+    )?;
+    let end_time = cx.bounded_or(
+        &d.end_time,
+        DEFAULT_END_TIME,
+        "deployment.end_time",
+        L::DURATION,
+    )?;
+    let output_rate = cx.bounded_or(
+        &d.output_rate,
+        DEFAULT_OUTPUT_RATE,
+        "deployment.output_rate",
+        L::OUTPUT_RATE,
+    )?;
+    let rows = crate::response::rows(end_time, output_rate);
+    if rows > crate::response::MAX_ROWS {
+        let span = d
+            .output_rate
+            .as_ref()
+            .or(d.end_time.as_ref())
+            .map_or(raw.span(), |v| v.span());
+        return Err(cx.invalid(
+            span,
+            "deployment.output_rate",
+            format!(
+                "{end_time} s at {output_rate} Hz would write {rows} rows; the limit is {} \
+                 (lower output_rate or end_time)",
+                crate::response::MAX_ROWS
+            ),
+        ));
+    }
+    Ok(Deployment {
+        plate: plate.name.clone(),
+        chain,
+        latching: match d.latching.as_ref().map(|l| *l.get_ref()) {
+            Some(RawLatching::Simultaneous) => Latching::Simultaneous,
+            _ => Latching::Sequential,
+        },
+        end_time,
+        output_rate,
+        tolerance,
+    })
+}
