@@ -77,6 +77,11 @@ impl DenseStep {
         }
     }
 
+    /// y at the step's start.
+    pub fn start(&self) -> &[f64] {
+        &self.r[0]
+    }
+
     /// Component i of y(t).
     pub fn component(&self, i: usize, t: f64) -> f64 {
         let s = (t - self.t0) / self.h;

@@ -14,20 +14,6 @@ fn v3(v: Vec3) -> [f64; 3] {
     v.0
 }
 
-/// Rigid-body velocity of the hub after the hand-over (translation m/s, rotation rad/s):
-/// the part of the hub's motion that grows linearly in time.
-fn hub_rigid_rates(sim: &Simulation, r: &Response) -> ([f64; 3], [f64; 3]) {
-    let (mut v, mut w) = ([0.0; 3], [0.0; 3]);
-    for m in r.modal.modes.iter().filter(|m| m.rigid) {
-        let shape = &sim.modes.modes[m.number - 1].shape;
-        for i in 0..3 {
-            v[i] += shape[i] * m.eta_dot0;
-            w[i] += shape[3 + i] * m.eta_dot0;
-        }
-    }
-    (v, w)
-}
-
 fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
     let h = &r.handover;
     let st = &s.response;
@@ -40,7 +26,7 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             json!({"name": ch.name, "label": ch.label, "unit": ch.unit, "peak": peak, "peak_time": at, "final": r.history.last(c)})
         })
         .collect();
-    let (rv, rw) = hub_rigid_rates(sim, r);
+    let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let last = |kind: ChannelKind| -> Vec<f64> {
         r.channels
             .iter()
@@ -121,7 +107,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
         },
         "handover": Value::Null,
         "response": Value::Null,
-        "warnings": s.deployment.as_ref().map_or(Vec::new(), |d| super::deploy_warnings(d, dep)).into_iter().chain(sim.warnings.iter().cloned()).collect::<Vec<_>>(),
+        "warnings": sim.all_warnings().map(ToString::to_string).collect::<Vec<_>>(),
     });
     if let Some(r) = &sim.response {
         let extra = response_json(sim, s, r);
@@ -241,7 +227,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             );
         }
     }
-    let (rv, rw) = hub_rigid_rates(sim, r);
+    let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let finals = |kind: ChannelKind| -> String {
         let v: Vec<String> = r
             .channels
