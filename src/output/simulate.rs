@@ -140,7 +140,6 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         let _ = writeln!(o, "\nno response: the array did not latch completely");
         return o;
     };
-    let h = &r.handover;
     let _ = writeln!(
         o,
         "\nResponse modes: {} rigid + {} of {} elastic kept",
@@ -171,6 +170,17 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             r.modal.modes.len() - shown
         );
     }
+    handover_lines(&mut o, r);
+    response_lines(&mut o, s, sim, r);
+    for w in &sim.warnings {
+        let _ = writeln!(o, "warning: {w}");
+    }
+    o
+}
+
+/// The hand-over's lines of the terminal summary.
+fn handover_lines(o: &mut String, r: &Response) {
+    let h = &r.handover;
     let lost = h.energy_before - h.energy_after;
     let _ = writeln!(
         o,
@@ -205,6 +215,10 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         f(h.momentum_after.linear),
         f(h.momentum_after.angular)
     );
+}
+
+/// The response's lines of the terminal summary.
+fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) {
     let st = &s.response;
     let _ = writeln!(
         o,
@@ -270,10 +284,6 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             st.damping_ratio
         );
     }
-    for w in &sim.warnings {
-        let _ = writeln!(o, "warning: {w}");
-    }
-    o
 }
 
 /// Writes summary.json, report.html, modes.json, the deployment's files, response.csv and
