@@ -54,3 +54,54 @@ pub fn earliest_latch(
     }
     event
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::deploy::integrator::{Dopri5, OdeSystem};
+
+    /// From y = (0, 1, 0): components sin t, cos t and 2 sin t.
+    struct Waves;
+
+    impl OdeSystem for Waves {
+        fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+            dy[0] = y[1];
+            dy[1] = -y[0];
+            dy[2] = 2.0 * y[1];
+        }
+    }
+
+    /// The first crossing over a tight adaptive run to t = 1 (hinge j on component j).
+    fn first(latch: &[f64], free: &[bool]) -> Option<Crossing> {
+        let mut s = Dopri5::new(1e-12, 1e-14, f64::INFINITY);
+        let (mut t, mut y) = (0.0, vec![0.0, 1.0, 0.0]);
+        while t < 1.0 {
+            let step = s.step(&Waves, &mut t, &mut y, 1.0);
+            if let Some(c) = earliest_latch(&step, 0, latch, free) {
+                return Some(c);
+            }
+        }
+        None
+    }
+
+    #[test]
+    fn the_earliest_crossing_of_a_free_hinge_is_located_to_1e_12() {
+        // cos t never rises to 1.5; sin t reaches 0.5 at π/6, 2 sin t at asin 0.25 (earlier).
+        let c = first(&[0.5, 1.5, 0.5], &[true, true, true]).expect("a crossing");
+        assert_eq!(c.hinge, 2);
+        assert!((c.t - 0.25_f64.asin()).abs() <= 1e-12, "{c:?}");
+        // With hinge 2 locked, hinge 0 at π/6.
+        let c = first(&[0.5, 1.5, 0.5], &[true, true, false]).expect("a crossing");
+        assert_eq!(c.hinge, 0);
+        assert!((c.t - std::f64::consts::FRAC_PI_6).abs() <= 1e-12, "{c:?}");
+        // Locked hinges are ignored; a free one that never reaches its latch gives none.
+        assert_eq!(first(&[0.5, 1.5, 0.5], &[false, true, false]), None);
+    }
+
+    #[test]
+    fn a_hinge_already_at_its_latch_angle_latches_at_the_step_start() {
+        // cos 0 = 1 ≥ 0.9: hinge 1 latches at t = 0, before the others' crossings.
+        let c = first(&[0.5, 0.9, 0.5], &[true, true, true]).expect("a crossing");
+        assert_eq!(c, Crossing { t: 0.0, hinge: 1 });
+    }
+}
