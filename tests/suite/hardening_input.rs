@@ -286,6 +286,14 @@ fn a_deployment_that_exceeds_its_step_limit_stops_with_a_status_not_a_hang() {
     assert!(full.all_latched && !full.step_limit_reached());
     let cut = flexcraft::deploy::simulate_limited(d, 50);
     assert!(cut.step_limit_reached());
+    assert_eq!(full.status, flexcraft::deploy::RunStatus::AllLatched);
+    assert_eq!(
+        cut.status,
+        flexcraft::deploy::RunStatus::StepLimit { t: cut.final_time }
+    );
+    assert!(cut
+        .warnings
+        .contains(&flexcraft::warning::Warning::StepLimit { t: cut.final_time }));
     assert!(!cut.all_latched);
     assert!(cut.final_time > 0.0 && cut.final_time < full.final_time);
     // The samples written up to the stop are those of the full run (same steps).
