@@ -27,6 +27,7 @@ pub mod ritz;
 pub mod scenario;
 pub mod simulation;
 pub mod structure;
+pub mod warning;
 
 pub use ritz::{ModalAnalysis, RitzModel};
 pub use scenario::Scenario;

@@ -9,6 +9,7 @@ use crate::response::{
 };
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
 use crate::scenario::Scenario;
+use crate::warning::Warning;
 
 /// Why `simulate` could not run at all.
 #[derive(Debug, thiserror::Error)]
@@ -48,12 +49,42 @@ pub struct Simulation {
     pub deployment: DeploymentResult,
     /// The response, when every hinge latched.
     pub response: Option<Response>,
-    /// Plain-language warnings of the hand-over and response (clamped mode count, hand-over
-    /// notes, …); the deployment's own are [`crate::output::deploy_warnings`].
-    pub warnings: Vec<String>,
+    /// Warnings of the hand-over and response (clamped mode count, hand-over notes, …); the
+    /// deployment's own are [`DeploymentResult::warnings`].
+    pub warnings: Vec<Warning>,
+}
+
+impl Response {
+    /// Rigid-body velocity of the hub after the hand-over (translation m/s, rotation rad/s):
+    /// the part of the hub's motion that grows linearly in time. `modes` are those the
+    /// response was built from.
+    pub fn hub_rigid_rates(&self, modes: &ModalAnalysis) -> ([f64; 3], [f64; 3]) {
+        let (mut v, mut w) = ([0.0; 3], [0.0; 3]);
+        for m in self.modal.modes.iter().filter(|m| m.rigid) {
+            let shape = &modes.modes[m.number - 1].shape;
+            for i in 0..3 {
+                v[i] += shape[i] * m.eta_dot0;
+                w[i] += shape[3 + i] * m.eta_dot0;
+            }
+        }
+        (v, w)
+    }
 }
 
 impl Simulation {
+    /// Every warning of the run: the deployment's, then those of the hand-over and response.
+    pub fn all_warnings(&self) -> impl Iterator<Item = &Warning> {
+        self.deployment.warnings.iter().chain(&self.warnings)
+    }
+
+    /// Rigid-body velocity of the hub after the hand-over (see [`Response::hub_rigid_rates`]);
+    /// `None` without a response.
+    pub fn hub_rigid_rates(&self) -> Option<([f64; 3], [f64; 3])> {
+        self.response
+            .as_ref()
+            .map(|r| r.hub_rigid_rates(&self.modes))
+    }
+
     /// Runs the whole chain for a scenario.
     pub fn run(scenario: &Scenario) -> Result<Self, SimulationError> {
         let d = scenario
@@ -67,22 +98,19 @@ impl Simulation {
         let mut warnings = Vec::new();
         let response = match hand_over(&model, &modes, d, &deployment, settings.handover) {
             Ok(handover) => {
-                warnings.extend(handover.notes.iter().cloned());
+                warnings.extend(handover.notes.iter().cloned().map(Warning::HandoverNote));
                 if handover.angle_mismatch > 1e-9 {
-                    warnings.push(format!(
-                        "the array locked away from the straight wing (largest hinge-angle \
-                         mismatch {:.6} rad): the hand-over uses the straight wing",
-                        handover.angle_mismatch
-                    ));
+                    warnings.push(Warning::AngleMismatch {
+                        rad: handover.angle_mismatch,
+                    });
                 }
                 let modal = ModalResponse::new(&modes, &handover.modal_velocity, settings);
                 if let Some(req) = settings.modes {
                     if req > modal.available_elastic {
-                        warnings.push(format!(
-                            "response.modes = {req} but the model has {} elastic modes: all of \
-                             them are kept",
-                            modal.available_elastic
-                        ));
+                        warnings.push(Warning::ModesClamped {
+                            requested: req,
+                            available: modal.available_elastic,
+                        });
                     }
                 }
                 let channels = standard_channels(&model);
@@ -96,9 +124,7 @@ impl Simulation {
                 })
             }
             Err(ResponseError::NotLatched { .. }) => {
-                warnings.push(
-                    "the array did not latch completely: no hand-over, no response".to_string(),
-                );
+                warnings.push(Warning::NoResponse);
                 None
             }
             Err(e) => return Err(e.into()),
@@ -124,7 +150,7 @@ fn large_deflections(
     model: &RitzModel,
     channels: &[Channel],
     history: &ResponseHistory,
-) -> Vec<String> {
+) -> Vec<Warning> {
     use crate::response::ChannelKind;
     let st = &model.structure;
     let mut out = Vec::new();
@@ -145,14 +171,12 @@ fn large_deflections(
             .map(|k| history.values[(k, j)].abs())
             .fold(0.0_f64, f64::max);
         if peak > SMALL_DEFLECTION_FRACTION * length {
-            out.push(format!(
-                "{}: peak elastic deflection {peak:.6e} m is {:.1} % of the component's length \
-                 {length} m: the linear (small-deformation) model is outside its assumption \
-                 there (more than {} %)",
-                c.label,
-                100.0 * peak / length,
-                100.0 * SMALL_DEFLECTION_FRACTION
-            ));
+            out.push(Warning::LargeDeflection {
+                label: c.label.clone(),
+                peak_m: peak,
+                length_m: length,
+                fraction: SMALL_DEFLECTION_FRACTION,
+            });
         }
     }
     out

@@ -1,13 +1,21 @@
 //! Deployment of an accordion-folded N-panel array (MODEL.md §3.2): the chain's dynamics
-//! ([`chain`]), an adaptive integrator with dense output ([`integrator`]), and the run with
-//! latch events, samples and warnings ([`simulate`]).
+//! ([`chain`]), an adaptive integrator with dense output ([`integrator`]), the latch-event
+//! finder ([`events`]), the swing-back tracker ([`swing`]), the chain of a plate of the 3-D
+//! structure ([`planar`]), and the run with latch events,
+//! samples, its status and warnings ([`simulate`]).
 
 pub mod chain;
+pub mod events;
 pub mod integrator;
 pub mod planar;
+pub mod swing;
 
+use crate::warning::Warning;
 use chain::{Chain, P2};
-use integrator::{locate, DenseStep, Dopri5, OdeSystem};
+use events::Crossing;
+use integrator::{DenseStep, Dopri5, OdeSystem};
+pub use swing::SwingBack;
+use swing::SwingTracker;
 
 /// When hinges lock.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,15 +98,25 @@ pub struct LatchEvent {
     pub qd_before: Vec<f64>,
 }
 
-/// A panel that swung back below its initial angle: the real array would collide there.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SwingBack {
-    /// Hinge (1-based).
-    pub hinge: usize,
-    /// First time below the initial angle, s.
-    pub first_time: f64,
-    /// Smallest angle reached, rad.
-    pub min_angle: f64,
+/// How a deployment run ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RunStatus {
+    /// Every hinge locked.
+    AllLatched,
+    /// The run reached its end time with some hinge still free.
+    EndTime,
+    /// The run took its step limit and was stopped at `t` (s) before its end (a stiff or
+    /// badly scaled problem; the result up to there is valid).
+    StepLimit {
+        /// Time the run stopped, s.
+        t: f64,
+    },
+    /// The integration produced a non-finite state and was stopped at `t` (s), the last
+    /// finite state.
+    Diverged {
+        /// Time of the last finite state, s.
+        t: f64,
+    },
 }
 
 /// The result of a deployment run.
@@ -108,7 +126,9 @@ pub struct DeploymentResult {
     pub samples: Vec<Sample>,
     /// Latch events in time order.
     pub latches: Vec<LatchEvent>,
-    /// Every hinge locked.
+    /// How the run ended.
+    pub status: RunStatus,
+    /// Every hinge locked (the same as `status == RunStatus::AllLatched`).
     pub all_latched: bool,
     /// Time the run ended, s.
     pub final_time: f64,
@@ -118,20 +138,29 @@ pub struct DeploymentResult {
     pub final_qd: Vec<f64>,
     /// Hinges that never latched: (hinge, final angle).
     pub unlatched: Vec<(usize, f64)>,
-    /// Swing-back warnings.
+    /// Swing-backs below the initial angle.
     pub swing_back: Vec<SwingBack>,
+    /// The run's warnings: swing-backs, divergence, step limit, unlatched hinges.
+    pub warnings: Vec<Warning>,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
-    /// The integration produced a non-finite state and was stopped there.
-    pub diverged: bool,
-    /// The run took [`MAX_STEPS`] steps and was stopped at `final_time` before its end
-    /// (a stiff or badly scaled problem; the result up to there is valid).
-    pub step_limit_reached: bool,
+}
+
+impl DeploymentResult {
+    /// The integration produced a non-finite state and was stopped at `final_time`.
+    pub fn diverged(&self) -> bool {
+        matches!(self.status, RunStatus::Diverged { .. })
+    }
+
+    /// The run took its step limit and was stopped at `final_time` before its end.
+    pub fn step_limit_reached(&self) -> bool {
+        matches!(self.status, RunStatus::StepLimit { .. })
+    }
 }
 
 /// Most integration steps one deployment run may take. A deterministic guard (a wall-time
 /// limit would make the result depend on the machine): a run of accepted values that would
-/// take longer stops with [`DeploymentResult::step_limit_reached`], never hangs. The seed
+/// take longer stops with [`RunStatus::StepLimit`] and a warning, never hangs. The seed
 /// example takes a few thousand steps.
 pub const MAX_STEPS: usize = 1_000_000;
 
@@ -178,6 +207,208 @@ fn sample(chain: &Chain, t: f64, y: &[f64], free: &[bool]) -> Sample {
     }
 }
 
+/// The impact at latch crossing `e`: `y` holds the state at the crossing; the hinges that
+/// lock (per `latching`) are fixed in `free`, the rates in `y` replaced by those after the
+/// impact. Returns the event.
+fn impact(
+    chain: &Chain,
+    latching: Latching,
+    e: Crossing,
+    y: &mut [f64],
+    free: &mut Vec<bool>,
+) -> LatchEvent {
+    let n = chain.dof();
+    let h = chain.hub_dof();
+    let mut free_after = free.clone();
+    match latching {
+        Latching::Sequential => free_after[h + e.hinge] = false,
+        Latching::Simultaneous => free_after[h..].iter_mut().for_each(|f| *f = false),
+    }
+    let (q, qd) = y.split_at(n);
+    let (qd_new, impulses) = chain.impact(q, qd, &free_after);
+    let locked = (0..chain.len())
+        .filter(|&i| free[h + i] && !free_after[h + i])
+        .map(|i| i + 1)
+        .collect();
+    let event = LatchEvent {
+        hinge: e.hinge + 1,
+        locked,
+        time: e.t,
+        angles: q[h..].to_vec(),
+        rates_before: qd[h..].to_vec(),
+        rates_after: qd_new[h..].to_vec(),
+        energy_before: chain.kinetic_energy(q, qd),
+        energy_after: chain.kinetic_energy(q, &qd_new),
+        impulses,
+        hub_rate_after: if h == 3 {
+            [qd_new[0], qd_new[1], qd_new[2]]
+        } else {
+            [0.0; 3]
+        },
+        q: q.to_vec(),
+        qd_before: qd.to_vec(),
+    };
+    y[n..].copy_from_slice(&qd_new);
+    *free = free_after;
+    event
+}
+
+/// The state of a run between steps.
+struct Run<'a> {
+    d: &'a Deployment,
+    sys: System<'a>,
+    latch_angles: Vec<f64>,
+    solver: Dopri5,
+    t: f64,
+    y: Vec<f64>,
+    samples: Vec<Sample>,
+    next_k: u64,
+    latches: Vec<LatchEvent>,
+    swing: SwingTracker,
+    buf: Vec<f64>,
+}
+
+impl<'a> Run<'a> {
+    fn new(d: &'a Deployment) -> Self {
+        let chain = &d.chain;
+        let n = chain.dof();
+        let (q0, qd0) = chain.initial_state();
+        let y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
+        let sys = System {
+            chain,
+            free: vec![true; n],
+        };
+        let samples = vec![sample(chain, 0.0, &y, &sys.free)];
+        Self {
+            d,
+            sys,
+            latch_angles: chain.hinges.iter().map(|j| j.latch_angle).collect(),
+            solver: Dopri5::new(d.tolerance, d.tolerance * 1e-2, f64::INFINITY),
+            t: 0.0,
+            y,
+            samples,
+            next_k: 1,
+            latches: Vec::new(),
+            swing: SwingTracker::new(chain.hinges.iter().map(|j| j.initial_angle).collect()),
+            buf: vec![0.0; 2 * n],
+        }
+    }
+
+    /// Some hinge is still free.
+    fn moving(&self) -> bool {
+        self.sys.free[self.sys.chain.hub_dof()..].iter().any(|f| *f)
+    }
+
+    /// One accepted step: its samples, the swing-back scan and the earliest latch in it.
+    /// False (and the state left at the step's start) when the step's state is not finite.
+    fn advance(&mut self) -> bool {
+        let h = self.sys.chain.hub_dof();
+        let n = self.sys.chain.dof();
+        let y_start = self.y.clone();
+        let step = self
+            .solver
+            .step(&self.sys, &mut self.t, &mut self.y, self.d.end_time);
+        if !self.y.iter().all(|v| v.is_finite()) {
+            self.y.copy_from_slice(&y_start);
+            self.t = step.t0;
+            return false;
+        }
+        let event = events::earliest_latch(&step, h, &self.latch_angles, &self.sys.free[h..]);
+        let t_limit = event.map_or(self.t, |e| e.t);
+        self.sample_until(&step, t_limit);
+        self.swing.scan(&step, h, t_limit);
+        match event {
+            None => self.swing.observe(self.t, &self.y[h..n]),
+            Some(e) => self.latch(&step, e),
+        }
+        true
+    }
+
+    /// Samples at k / rate within (step.t0, t_limit].
+    fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
+        let chain = self.sys.chain;
+        let (h, n) = (chain.hub_dof(), chain.dof());
+        loop {
+            let tk = self.next_k as f64 / self.d.output_rate;
+            if tk > t_limit || tk > self.d.end_time {
+                break;
+            }
+            step.eval(tk, &mut self.buf);
+            self.swing.observe(tk, &self.buf[h..n]);
+            self.samples
+                .push(sample(chain, tk, &self.buf, &self.sys.free));
+            self.next_k += 1;
+        }
+    }
+
+    /// The latch at crossing `e` of `step`: the state moves to the crossing, the impact
+    /// applies, and samples just before and after are recorded.
+    fn latch(&mut self, step: &DenseStep, e: Crossing) {
+        let chain = self.sys.chain;
+        let h = chain.hub_dof();
+        step.eval(e.t, &mut self.y);
+        self.y[h + e.hinge] = self.latch_angles[e.hinge];
+        self.t = e.t;
+        let before = sample(chain, e.t, &self.y, &self.sys.free);
+        let event = impact(chain, self.d.latching, e, &mut self.y, &mut self.sys.free);
+        self.latches.push(event);
+        if self.samples.last().is_none_or(|s| s.t < e.t) {
+            self.samples.push(before);
+        }
+        self.samples
+            .push(sample(chain, e.t, &self.y, &self.sys.free));
+        self.solver.restart();
+    }
+
+    fn finish(self, out_of_steps: bool, diverged: bool) -> DeploymentResult {
+        let chain = self.sys.chain;
+        let (h, n) = (chain.hub_dof(), chain.dof());
+        let all_latched = !self.moving();
+        let t = self.t;
+        let status = if diverged {
+            RunStatus::Diverged { t }
+        } else if all_latched {
+            RunStatus::AllLatched
+        } else if out_of_steps && t < self.d.end_time {
+            RunStatus::StepLimit { t }
+        } else {
+            RunStatus::EndTime
+        };
+        let unlatched: Vec<(usize, f64)> = (0..chain.len())
+            .filter(|&i| self.sys.free[h + i])
+            .map(|i| (i + 1, self.y[h + i]))
+            .collect();
+        let (swing_back, mut warnings) = self.swing.finish();
+        match status {
+            RunStatus::Diverged { t } => warnings.push(Warning::Diverged { t }),
+            RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
+            RunStatus::AllLatched | RunStatus::EndTime => {}
+        }
+        if !all_latched {
+            warnings.push(Warning::NotLatched {
+                t,
+                hinges: unlatched
+                    .iter()
+                    .map(|&(i, a)| (i, a, self.latch_angles[i - 1]))
+                    .collect(),
+            });
+        }
+        DeploymentResult {
+            samples: self.samples,
+            latches: self.latches,
+            status,
+            all_latched,
+            final_time: t,
+            final_q: self.y[..n].to_vec(),
+            final_qd: self.y[n..].to_vec(),
+            unlatched,
+            swing_back,
+            warnings,
+            evaluations: self.solver.evaluations,
+        }
+    }
+}
+
 /// Runs the deployment until every hinge has latched or `end_time` (at most [`MAX_STEPS`]
 /// steps).
 pub fn simulate(d: &Deployment) -> DeploymentResult {
@@ -185,197 +416,17 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
 }
 
 /// [`simulate`] with a step limit of the caller's choosing: the run stops after `max_steps`
-/// steps with [`DeploymentResult::step_limit_reached`] set.
+/// steps with [`RunStatus::StepLimit`] (and its warning).
 pub fn simulate_limited(d: &Deployment, max_steps: usize) -> DeploymentResult {
-    let chain = &d.chain;
-    let n = chain.dof();
-    let h = chain.hub_dof();
-    let nh = chain.len();
-    let (q0, qd0) = chain.initial_state();
-    let mut y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
-    let mut sys = System {
-        chain,
-        free: vec![true; n],
-    };
-    let mut solver = Dopri5::new(d.tolerance, d.tolerance * 1e-2, f64::INFINITY);
-    let mut t = 0.0;
-    let mut samples = vec![sample(chain, 0.0, &y, &sys.free)];
-    let mut next_k: u64 = 1;
-    let mut latches = Vec::new();
-    let mut swing: Vec<Option<SwingBack>> = vec![None; nh];
-    let event_tol = 1e-12;
-    let mut buf = vec![0.0; 2 * n];
+    let mut run = Run::new(d);
     let mut steps = 0usize;
     let mut diverged = false;
-
-    let check_swing = |swing: &mut Vec<Option<SwingBack>>, t: f64, alpha: &[f64]| {
-        for (i, a) in alpha.iter().enumerate() {
-            let a0 = chain.hinges[i].initial_angle;
-            if *a < a0 - 1e-12 {
-                match &mut swing[i] {
-                    Some(s) => s.min_angle = s.min_angle.min(*a),
-                    None => {
-                        swing[i] = Some(SwingBack {
-                            hinge: i + 1,
-                            first_time: t,
-                            min_angle: *a,
-                        })
-                    }
-                }
-            }
-        }
-    };
-
-    while t < d.end_time && sys.free[h..].iter().any(|f| *f) && steps < max_steps {
+    while run.t < d.end_time && run.moving() && steps < max_steps {
         steps += 1;
-        let t_start = t;
-        let y_start = y.clone();
-        let step: DenseStep = solver.step(&sys, &mut t, &mut y, d.end_time);
-        if !y.iter().all(|v| v.is_finite()) {
-            y.copy_from_slice(&y_start);
-            t = t_start;
+        if !run.advance() {
             diverged = true;
             break;
         }
-        // The earliest latch crossing in this step.
-        let mut event: Option<(f64, usize)> = None;
-        for j in 0..nh {
-            if !sys.free[h + j] {
-                continue;
-            }
-            let latch = chain.hinges[j].latch_angle;
-            let g = |tt: f64| step.component(h + j, tt) - latch;
-            let g0 = y_start[h + j] - latch;
-            if g0 >= 0.0 {
-                // Already at the latch angle at the step's start (cannot happen for a
-                // validated scenario except after rounding): latch now.
-                event = Some((t_start, j));
-                break;
-            }
-            // Sample the step's interior so that a crossing and return within one step
-            // is not missed.
-            let mut a = t_start;
-            for s in 1..=8 {
-                let b = t_start + step.h * s as f64 / 8.0;
-                if g(b) >= 0.0 {
-                    let te = locate(g, a, b, event_tol * b.abs().max(1.0));
-                    if event.is_none_or(|(t_ev, _)| te < t_ev) {
-                        event = Some((te, j));
-                    }
-                    break;
-                }
-                a = b;
-            }
-        }
-        let t_limit = event.map_or(t, |e| e.0);
-        // Samples at k / rate within (t_start, t_limit].
-        loop {
-            let tk = next_k as f64 / d.output_rate;
-            if tk > t_limit || tk > d.end_time {
-                break;
-            }
-            step.eval(tk, &mut buf);
-            check_swing(&mut swing, tk, &buf[h..n]);
-            samples.push(sample(chain, tk, &buf, &sys.free));
-            next_k += 1;
-        }
-        // Swing-back below the initial angle: locate its first time on the dense output.
-        let t_seen = event.map_or(t, |e| e.0);
-        for i in 0..nh {
-            let a0 = chain.hinges[i].initial_angle;
-            let g = |tt: f64| a0 - 1e-12 - step.component(h + i, tt);
-            let mut a = t_start;
-            for s in 1..=8 {
-                let b = t_start + (t_seen - t_start) * s as f64 / 8.0;
-                let gb = g(b);
-                if gb > 0.0 {
-                    let first = if swing[i].is_none() && g(a) <= 0.0 {
-                        locate(g, a, b, event_tol * b.abs().max(1.0))
-                    } else {
-                        b
-                    };
-                    let angle = step.component(h + i, b);
-                    match &mut swing[i] {
-                        Some(sb) => sb.min_angle = sb.min_angle.min(angle),
-                        None => {
-                            swing[i] = Some(SwingBack {
-                                hinge: i + 1,
-                                first_time: first,
-                                min_angle: angle,
-                            })
-                        }
-                    }
-                }
-                a = b;
-            }
-        }
-        match event {
-            None => check_swing(&mut swing, t, &y[h..n]),
-            Some((te, j)) => {
-                step.eval(te, &mut y);
-                y[h + j] = chain.hinges[j].latch_angle;
-                t = te;
-                let (q, qd) = y.split_at(n);
-                let before = sample(chain, te, &y, &sys.free);
-                let mut free_after = sys.free.clone();
-                match d.latching {
-                    Latching::Sequential => free_after[h + j] = false,
-                    Latching::Simultaneous => free_after[h..].iter_mut().for_each(|f| *f = false),
-                }
-                let (qd_new, impulses) = chain.impact(q, qd, &free_after);
-                let locked: Vec<usize> = (0..nh)
-                    .filter(|&i| sys.free[h + i] && !free_after[h + i])
-                    .map(|i| i + 1)
-                    .collect();
-                let rates_before = qd[h..].to_vec();
-                let qd_before = qd.to_vec();
-                let energy_before = chain.kinetic_energy(q, qd);
-                let q = q.to_vec();
-                y[n..].copy_from_slice(&qd_new);
-                sys.free = free_after;
-                let energy_after = chain.kinetic_energy(&q, &qd_new);
-                latches.push(LatchEvent {
-                    hinge: j + 1,
-                    locked,
-                    time: te,
-                    angles: q[h..].to_vec(),
-                    rates_before,
-                    rates_after: qd_new[h..].to_vec(),
-                    energy_before,
-                    energy_after,
-                    impulses,
-                    hub_rate_after: if h == 3 {
-                        [qd_new[0], qd_new[1], qd_new[2]]
-                    } else {
-                        [0.0; 3]
-                    },
-                    q: q.clone(),
-                    qd_before,
-                });
-                if samples.last().is_none_or(|s| s.t < te) {
-                    samples.push(before);
-                }
-                samples.push(sample(chain, te, &y, &sys.free));
-                solver.restart();
-            }
-        }
     }
-    let all_latched = sys.free[h..].iter().all(|f| !f);
-    let unlatched = (0..nh)
-        .filter(|&i| sys.free[h + i])
-        .map(|i| (i + 1, y[h + i]))
-        .collect();
-    DeploymentResult {
-        samples,
-        latches,
-        all_latched,
-        final_time: t,
-        final_q: y[..n].to_vec(),
-        final_qd: y[n..].to_vec(),
-        unlatched,
-        swing_back: swing.into_iter().flatten().collect(),
-        evaluations: solver.evaluations,
-        step_limit_reached: steps >= max_steps && !diverged && t < d.end_time && !all_latched,
-        diverged,
-    }
+    run.finish(steps >= max_steps, diverged)
 }

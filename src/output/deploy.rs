@@ -14,53 +14,6 @@ fn latching_name(l: Latching) -> &'static str {
     }
 }
 
-/// Plain-language warnings: swing-back (collision in the real array) and unlatched hinges.
-pub fn deploy_warnings(d: &Deployment, r: &DeploymentResult) -> Vec<String> {
-    let mut w = Vec::new();
-    for s in &r.swing_back {
-        let into = if s.hinge == 1 {
-            "the hub".to_string()
-        } else {
-            format!("panel {}", s.hinge - 1)
-        };
-        w.push(format!(
-            "panel {} swings back below its initial angle from t = {:.6} s (minimum α_{} = {:.6} rad, initial {:.6} rad): the real array would collide with {into} there (no contact model)",
-            s.hinge, s.first_time, s.hinge, s.min_angle, d.chain.hinges[s.hinge - 1].initial_angle
-        ));
-    }
-    if r.diverged {
-        w.push(format!(
-            "the integration diverged (non-finite state) at t = {} s and was stopped there",
-            r.final_time
-        ));
-    }
-    if r.step_limit_reached {
-        w.push(format!(
-            "step limit reached at t = {} s: the integration was stopped there after its \
-             step limit (a stiff or badly scaled deployment; the results up to t are valid)",
-            r.final_time
-        ));
-    }
-    if !r.all_latched {
-        let list: Vec<String> = r
-            .unlatched
-            .iter()
-            .map(|(h, a)| {
-                format!(
-                    "hinge {h} at {a:.6} rad (latch {:.6} rad)",
-                    d.chain.hinges[h - 1].latch_angle
-                )
-            })
-            .collect();
-        w.push(format!(
-            "not all hinges latched by t = {} s: {}",
-            r.final_time,
-            list.join(", ")
-        ));
-    }
-    w
-}
-
 fn hub_json(d: &Deployment, r: &DeploymentResult) -> Value {
     match d.chain.hub {
         PlanarHub::Fixed => json!({"motion": "fixed"}),
@@ -113,7 +66,7 @@ pub fn deploy_json(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
         "final_time": r.final_time,
         "unlatched": r.unlatched.iter().map(|(h, a)| json!({"hinge": h, "angle": a})).collect::<Vec<_>>(),
         "swing_back": r.swing_back.iter().map(|s| json!({"hinge": s.hinge, "first_time": s.first_time, "min_angle": s.min_angle})).collect::<Vec<_>>(),
-        "warnings": deploy_warnings(d, r),
+        "warnings": r.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
         "hub": hub_json(d, r),
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
@@ -192,7 +145,7 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
             r.final_q[0], r.final_q[1], r.final_q[2], r.final_qd[0], r.final_qd[1], r.final_qd[2]
         );
     }
-    for w in deploy_warnings(d, r) {
+    for w in &r.warnings {
         let _ = writeln!(s, "warning: {w}");
     }
     s

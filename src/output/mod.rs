@@ -13,7 +13,7 @@ mod report;
 mod simulate;
 
 pub use atomic::{OutputDir, MARKER};
-pub use deploy::{deploy_json, deploy_table, deploy_warnings, write_deploy};
+pub use deploy::{deploy_json, deploy_table, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
 pub use names::file_stems;
 pub use report::report_html;

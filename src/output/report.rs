@@ -487,8 +487,8 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
         );
     }
     o.push_str("</table>\n");
-    for w in super::deploy_warnings(d, r) {
-        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w));
+    for w in &r.warnings {
+        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
     for f in super::figures::deployment_figures(d, r) {
         o.push_str(&plot(&f));
@@ -589,7 +589,7 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     }
     o.push_str("</table>\n");
     for w in &sim.warnings {
-        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(w));
+        let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
     for f in super::figures::response_figures(s, r) {
         o.push_str(&plot(&f));

@@ -14,20 +14,6 @@ fn v3(v: Vec3) -> [f64; 3] {
     v.0
 }
 
-/// Rigid-body velocity of the hub after the hand-over (translation m/s, rotation rad/s):
-/// the part of the hub's motion that grows linearly in time.
-fn hub_rigid_rates(sim: &Simulation, r: &Response) -> ([f64; 3], [f64; 3]) {
-    let (mut v, mut w) = ([0.0; 3], [0.0; 3]);
-    for m in r.modal.modes.iter().filter(|m| m.rigid) {
-        let shape = &sim.modes.modes[m.number - 1].shape;
-        for i in 0..3 {
-            v[i] += shape[i] * m.eta_dot0;
-            w[i] += shape[3 + i] * m.eta_dot0;
-        }
-    }
-    (v, w)
-}
-
 fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
     let h = &r.handover;
     let st = &s.response;
@@ -40,7 +26,7 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             json!({"name": ch.name, "label": ch.label, "unit": ch.unit, "peak": peak, "peak_time": at, "final": r.history.last(c)})
         })
         .collect();
-    let (rv, rw) = hub_rigid_rates(sim, r);
+    let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let last = |kind: ChannelKind| -> Vec<f64> {
         r.channels
             .iter()
@@ -121,7 +107,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
         },
         "handover": Value::Null,
         "response": Value::Null,
-        "warnings": s.deployment.as_ref().map_or(Vec::new(), |d| super::deploy_warnings(d, dep)).into_iter().chain(sim.warnings.iter().cloned()).collect::<Vec<_>>(),
+        "warnings": sim.all_warnings().map(ToString::to_string).collect::<Vec<_>>(),
     });
     if let Some(r) = &sim.response {
         let extra = response_json(sim, s, r);
@@ -154,7 +140,6 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         let _ = writeln!(o, "\nno response: the array did not latch completely");
         return o;
     };
-    let h = &r.handover;
     let _ = writeln!(
         o,
         "\nResponse modes: {} rigid + {} of {} elastic kept",
@@ -185,6 +170,17 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             r.modal.modes.len() - shown
         );
     }
+    handover_lines(&mut o, r);
+    response_lines(&mut o, s, sim, r);
+    for w in &sim.warnings {
+        let _ = writeln!(o, "warning: {w}");
+    }
+    o
+}
+
+/// The hand-over's lines of the terminal summary.
+fn handover_lines(o: &mut String, r: &Response) {
+    let h = &r.handover;
     let lost = h.energy_before - h.energy_after;
     let _ = writeln!(
         o,
@@ -219,6 +215,10 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
         f(h.momentum_after.linear),
         f(h.momentum_after.angular)
     );
+}
+
+/// The response's lines of the terminal summary.
+fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) {
     let st = &s.response;
     let _ = writeln!(
         o,
@@ -241,7 +241,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             );
         }
     }
-    let (rv, rw) = hub_rigid_rates(sim, r);
+    let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let finals = |kind: ChannelKind| -> String {
         let v: Vec<String> = r
             .channels
@@ -284,10 +284,6 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             st.damping_ratio
         );
     }
-    for w in &sim.warnings {
-        let _ = writeln!(o, "warning: {w}");
-    }
-    o
 }
 
 /// Writes summary.json, report.html, modes.json, the deployment's files, response.csv and

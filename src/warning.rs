@@ -1,0 +1,139 @@
+//! Typed warnings of a run. The physics modules ([`crate::deploy`],
+//! [`crate::simulation`]) produce them; the output layer only renders them, through their
+//! [`Display`](std::fmt::Display) text.
+
+use std::fmt;
+
+/// Something a run wants the user to know: a result outside the model's assumptions or a run
+/// that stopped before its end.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Warning {
+    /// A panel swung back below its initial angle: the real array would collide there.
+    SwingBack {
+        /// Hinge (1-based).
+        hinge: usize,
+        /// First time below the initial angle, s.
+        first_time: f64,
+        /// Smallest angle reached, rad.
+        min_angle: f64,
+        /// The hinge's initial angle, rad.
+        initial_angle: f64,
+    },
+    /// The deployment's integration produced a non-finite state at `t` (s) and stopped there.
+    Diverged {
+        /// Time of the last finite state, s.
+        t: f64,
+    },
+    /// The deployment took its step limit and stopped at `t` (s).
+    StepLimit {
+        /// Time the run stopped, s.
+        t: f64,
+    },
+    /// Hinges that had not latched when the deployment ended at `t` (s).
+    NotLatched {
+        /// Time the run ended, s.
+        t: f64,
+        /// Per unlatched hinge: (hinge, 1-based; final angle, rad; latch angle, rad).
+        hinges: Vec<(usize, f64, f64)>,
+    },
+    /// No hand-over and no response, because the array did not latch completely.
+    NoResponse,
+    /// More elastic modes requested than the model has: all are kept.
+    ModesClamped {
+        /// `response.modes`.
+        requested: usize,
+        /// Elastic modes of the model.
+        available: usize,
+    },
+    /// The array locked away from the straight wing; the hand-over uses the straight wing.
+    AngleMismatch {
+        /// Largest hinge-angle mismatch, rad.
+        rad: f64,
+    },
+    /// A tip's peak elastic deflection is beyond the small-deformation assumption.
+    LargeDeflection {
+        /// The channel's label.
+        label: String,
+        /// Peak elastic deflection, m.
+        peak_m: f64,
+        /// The component's length, m.
+        length_m: f64,
+        /// The threshold, as a fraction of the length.
+        fraction: f64,
+    },
+    /// A note of the hand-over, in plain language.
+    HandoverNote(String),
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::SwingBack {
+                hinge,
+                first_time,
+                min_angle,
+                initial_angle,
+            } => {
+                let into = if *hinge == 1 {
+                    "the hub".to_string()
+                } else {
+                    format!("panel {}", hinge - 1)
+                };
+                write!(
+                    f,
+                    "panel {hinge} swings back below its initial angle from t = {first_time:.6} s (minimum α_{hinge} = {min_angle:.6} rad, initial {initial_angle:.6} rad): the real array would collide with {into} there (no contact model)"
+                )
+            }
+            Self::Diverged { t } => write!(
+                f,
+                "the integration diverged (non-finite state) at t = {t} s and was stopped there"
+            ),
+            Self::StepLimit { t } => write!(
+                f,
+                "step limit reached at t = {t} s: the integration was stopped there after its \
+                 step limit (a stiff or badly scaled deployment; the results up to t are valid)"
+            ),
+            Self::NotLatched { t, hinges } => {
+                let list: Vec<String> = hinges
+                    .iter()
+                    .map(|(h, a, latch)| format!("hinge {h} at {a:.6} rad (latch {latch:.6} rad)"))
+                    .collect();
+                write!(
+                    f,
+                    "not all hinges latched by t = {t} s: {}",
+                    list.join(", ")
+                )
+            }
+            Self::NoResponse => {
+                f.write_str("the array did not latch completely: no hand-over, no response")
+            }
+            Self::ModesClamped {
+                requested,
+                available,
+            } => write!(
+                f,
+                "response.modes = {requested} but the model has {available} elastic modes: all \
+                 of them are kept"
+            ),
+            Self::AngleMismatch { rad } => write!(
+                f,
+                "the array locked away from the straight wing (largest hinge-angle mismatch \
+                 {rad:.6} rad): the hand-over uses the straight wing"
+            ),
+            Self::LargeDeflection {
+                label,
+                peak_m,
+                length_m,
+                fraction,
+            } => write!(
+                f,
+                "{label}: peak elastic deflection {peak_m:.6e} m is {:.1} % of the component's \
+                 length {length_m} m: the linear (small-deformation) model is outside its \
+                 assumption there (more than {} %)",
+                100.0 * peak_m / length_m,
+                100.0 * fraction
+            ),
+            Self::HandoverNote(note) => f.write_str(note),
+        }
+    }
+}
