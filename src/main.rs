@@ -260,8 +260,18 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     let progress = Progress::new(quiet);
     let scenario = load(c)?;
     need_deployment(path, &scenario)?;
+    // The report's footer carries the SHA-256 of the file as read here. The scenario was
+    // parsed by `Scenario::from_file` (size cap, UTF-8 error locations), so the bytes are
+    // read a second time; if that read fails (the file was removed or replaced meanwhile)
+    // the run stops rather than hash nothing.
+    let source = std::fs::read(path).map_err(|e| {
+        eprintln!(
+            "error: {}: reading it again for its SHA-256: {e}",
+            path.display()
+        );
+        ExitCode::from(FAILED)
+    })?;
     let staged = prepare(out, c.force)?;
-    let source = std::fs::read(path).unwrap_or_default();
     progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| match &e {
         flexcraft::simulation::SimulationError::Ritz(r) => {

@@ -71,7 +71,10 @@ pub fn generalized_symmetric(
     // without favouring any mode.
     let phi = Mat::from_fn(n, n, |i, j| phi[(i, pairs[j].2)] / pairs[j].1.sqrt());
     let e = phi.transpose() * (m * &phi);
-    let half = Mat::from_fn(n, n, |i, j| if i == j { 1.0 } else { 0.0 } - 0.25 * (e[(i, j)] + e[(j, i)] - if i == j { 2.0 } else { 0.0 }));
+    let half = Mat::from_fn(n, n, |i, j| {
+        let delta = if i == j { 1.0 } else { 0.0 };
+        delta - 0.25 * (e[(i, j)] + e[(j, i)] - 2.0 * delta)
+    });
     let phi = &phi * &half;
     Ok((lambda, phi))
 }

@@ -312,7 +312,6 @@ fn rigid_modes(model: &RitzModel, mrr: &Mat<f64>) -> Vec<Mode> {
         fix_sign(&mut shape);
         out.push(Mode::rigid_body(shape));
     }
-    let _ = n;
     out
 }
 
