@@ -17,13 +17,14 @@ pub const DEFAULT_OUTPUT_RATE: f64 = 10.0;
 /// Default relative integration tolerance.
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
 
-/// Builds the deployment chain from `[deployment]` and the structure (MODEL.md §3.2).
+/// Builds the deployment from `[deployment]` and the structure: the deploying plate, its
+/// panels and hinges, the run settings; the chain itself comes from
+/// [`crate::deploy::planar::chain_of_plate`].
 pub(super) fn lower(
     cx: &Ctx,
     raw: &S<RawDeployment>,
     st: &Structure,
 ) -> Result<Deployment, ScenarioError> {
-    use std::f64::consts::PI;
     let d = raw.get_ref();
     let plate_index = st
         .plates
@@ -46,7 +47,49 @@ pub(super) fn lower(
             )
         })?;
     let plate = &st.plates[plate_index];
-    let lengths: Vec<f64> = match (&d.panels, &d.panel_lengths) {
+    let lengths = panel_lengths(cx, raw, plate)?;
+    let panel_mass = match &d.panel_mass {
+        Some(m) => Some(cx.bounded(m, "deployment.panel_mass", L::MASS)?),
+        None => None,
+    };
+    let panel_inertia = match &d.panel_inertia {
+        Some(m) => Some(cx.bounded(m, "deployment.panel_inertia", L::PANEL_INERTIA)?),
+        None => None,
+    };
+    let hinges = hinges(cx, raw, lengths.len())?;
+    let chain = crate::deploy::planar::chain_of_plate(
+        st,
+        plate_index,
+        &lengths,
+        crate::deploy::planar::PanelOverrides {
+            mass: panel_mass,
+            inertia: panel_inertia,
+        },
+        hinges,
+        matches!(d.hub.as_ref().map(|h| *h.get_ref()), Some(RawMotion::Free)),
+    );
+    let (end_time, output_rate, tolerance) = run_settings(cx, raw)?;
+    Ok(Deployment {
+        plate: plate.name.clone(),
+        chain,
+        latching: match d.latching.as_ref().map(|l| *l.get_ref()) {
+            Some(RawLatching::Simultaneous) => Latching::Simultaneous,
+            _ => Latching::Sequential,
+        },
+        end_time,
+        output_rate,
+        tolerance,
+    })
+}
+
+/// `panels` (equal lengths) or `panel_lengths` (summing to the plate's length).
+fn panel_lengths(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+    plate: &crate::structure::Plate,
+) -> Result<Vec<f64>, ScenarioError> {
+    let d = raw.get_ref();
+    Ok(match (&d.panels, &d.panel_lengths) {
         (Some(_), Some(l)) => {
             return Err(cx.invalid(
                 l.span(),
@@ -117,40 +160,14 @@ pub(super) fn lower(
                 "missing: give panels or panel_lengths",
             ))
         }
-    };
-    let n = lengths.len();
-    let panel_mass = match &d.panel_mass {
-        Some(m) => Some(cx.bounded(m, "deployment.panel_mass", L::MASS)?),
-        None => None,
-    };
-    let panel_inertia = match &d.panel_inertia {
-        Some(m) => Some(cx.bounded(m, "deployment.panel_inertia", L::PANEL_INERTIA)?),
-        None => None,
-    };
-    // Hinges: [deployment.hinge] for all, [[deployment.hinges]] per hinge overriding it.
-    let all = d.hinge.as_ref().map(|h| h.get_ref());
-    let k_all = match all.and_then(|h| h.stiffness.as_ref()) {
-        Some(k) => Some(cx.bounded(k, "deployment.hinge.stiffness", L::HINGE_STIFFNESS)?),
-        None => None,
-    };
-    let preload = cx.bounded_or(
-        &all.and_then(|h| h.preload_angle.clone()),
-        0.0,
-        "deployment.hinge.preload_angle",
-        L::ANGLE,
-    )?;
-    let damping_all = cx.bounded_or(
-        &all.and_then(|h| h.damping.clone()),
-        0.0,
-        "deployment.hinge.damping",
-        L::HINGE_DAMPING,
-    )?;
-    let friction_all = cx.bounded_or(
-        &all.and_then(|h| h.friction.clone()),
-        0.0,
-        "deployment.hinge.friction",
-        L::HINGE_FRICTION,
-    )?;
+    })
+}
+
+/// `[deployment.hinge]` for every hinge, `[[deployment.hinges]]` per hinge overriding it.
+fn hinges(cx: &Ctx, raw: &S<RawDeployment>, n: usize) -> Result<Vec<Hinge>, ScenarioError> {
+    use std::f64::consts::PI;
+    let d = raw.get_ref();
+    let (k_all, preload, damping_all, friction_all) = common_hinge(cx, raw)?;
     if let Some(list) = &d.hinges {
         if list.len() != n {
             let span = list.first().map_or(raw.span(), |h| h.span());
@@ -246,17 +263,43 @@ pub(super) fn lower(
             )?,
         });
     }
-    let chain = crate::deploy::planar::chain_of_plate(
-        st,
-        plate_index,
-        &lengths,
-        crate::deploy::planar::PanelOverrides {
-            mass: panel_mass,
-            inertia: panel_inertia,
-        },
-        hinges,
-        matches!(d.hub.as_ref().map(|h| *h.get_ref()), Some(RawMotion::Free)),
-    );
+    Ok(hinges)
+}
+
+/// `[deployment.hinge]`: stiffness (if given), preload, damping and friction for every hinge.
+fn common_hinge(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+) -> Result<(Option<f64>, f64, f64, f64), ScenarioError> {
+    let all = raw.get_ref().hinge.as_ref().map(|h| h.get_ref());
+    let k_all = match all.and_then(|h| h.stiffness.as_ref()) {
+        Some(k) => Some(cx.bounded(k, "deployment.hinge.stiffness", L::HINGE_STIFFNESS)?),
+        None => None,
+    };
+    let preload = cx.bounded_or(
+        &all.and_then(|h| h.preload_angle.clone()),
+        0.0,
+        "deployment.hinge.preload_angle",
+        L::ANGLE,
+    )?;
+    let damping_all = cx.bounded_or(
+        &all.and_then(|h| h.damping.clone()),
+        0.0,
+        "deployment.hinge.damping",
+        L::HINGE_DAMPING,
+    )?;
+    let friction_all = cx.bounded_or(
+        &all.and_then(|h| h.friction.clone()),
+        0.0,
+        "deployment.hinge.friction",
+        L::HINGE_FRICTION,
+    )?;
+    Ok((k_all, preload, damping_all, friction_all))
+}
+
+/// End time, output rate (with the row cap) and tolerance.
+fn run_settings(cx: &Ctx, raw: &S<RawDeployment>) -> Result<(f64, f64, f64), ScenarioError> {
+    let d = raw.get_ref();
     let tolerance = cx.bounded_or(
         &d.tolerance,
         DEFAULT_TOLERANCE,
@@ -292,15 +335,5 @@ pub(super) fn lower(
             ),
         ));
     }
-    Ok(Deployment {
-        plate: plate.name.clone(),
-        chain,
-        latching: match d.latching.as_ref().map(|l| *l.get_ref()) {
-            Some(RawLatching::Simultaneous) => Latching::Simultaneous,
-            _ => Latching::Sequential,
-        },
-        end_time,
-        output_rate,
-        tolerance,
-    })
+    Ok((end_time, output_rate, tolerance))
 }
