@@ -13,6 +13,7 @@ use crate::warning::Warning;
 
 /// Why `simulate` could not run at all.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum SimulationError {
     /// `simulate` needs a `[deployment]` section.
     #[error("the scenario has no [deployment] section (see docs/scenario.md)")]

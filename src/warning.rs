@@ -7,6 +7,7 @@ use std::fmt;
 /// Something a run wants the user to know: a result outside the model's assumptions or a run
 /// that stopped before its end.
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum Warning {
     /// A panel swung back below its initial angle: the real array would collide there.
     SwingBack {

@@ -5,8 +5,8 @@
 //! samples, its status and warnings ([`simulate`]).
 
 pub mod chain;
-pub mod events;
-pub mod integrator;
+pub(crate) mod events;
+pub(crate) mod integrator;
 pub mod planar;
 pub mod swing;
 
@@ -100,6 +100,7 @@ pub struct LatchEvent {
 
 /// How a deployment run ended.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum RunStatus {
     /// Every hinge locked.
     AllLatched,

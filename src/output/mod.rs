@@ -8,7 +8,7 @@ pub mod figures;
 mod hostile_names_test;
 mod modes;
 mod names;
-pub mod plot;
+pub(crate) mod plot;
 mod report;
 mod simulate;
 
@@ -28,6 +28,7 @@ fn num(v: f64) -> String {
 
 /// Failure to write an output.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum OutputError {
     /// File-system error.
     #[error("{0}")]

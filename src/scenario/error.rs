@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// What kind of problem the scenario has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ErrorKind {
     /// The file could not be read.
     Io,

@@ -156,3 +156,54 @@ fn fixed_hub_modes_equal_hub_fixed_list() {
         assert!(f.omega_rad_s >= x.omega_rad_s * (1.0 - 1e-12));
     }
 }
+
+/// Second route to the same model: the free-hub example built in code through the
+/// structure's constructors gives exactly the modes of the parsed scenario.
+#[test]
+fn val_a_structure_built_in_code_equals_the_parsed_one() {
+    use flexcraft::math::Vec3;
+    use flexcraft::structure::*;
+    let parsed = crate::suite::common::scenario(include_str!("../../examples/free_hub.toml"));
+    let hub = Hub::new(
+        HubMotion::Free,
+        500.0,
+        Vec3::ZERO,
+        inertia_tensor(&[300.0, 400.0, 350.0]).unwrap(),
+    )
+    .unwrap();
+    let wing = Plate::new(PlateSpec {
+        name: "wing".into(),
+        attachment: Attachment::Hub {
+            point: Vec3([1.2, 0.0, 0.4]),
+        },
+        length_axis: Vec3([1.0, 0.0, 0.0]),
+        normal: Vec3([0.0, 0.0, 1.0]),
+        length: 6.0,
+        width: 1.5,
+        stiffness: PlateStiffness::Given {
+            areal_density: 5.0,
+            bending_stiffness: 2.0e4,
+            poisson_ratio: 0.3,
+        },
+        terms: PlateTerms::new(10, 4).unwrap(),
+    })
+    .unwrap();
+    let built = Structure::new(Parts {
+        name: parsed.structure.name().to_string(),
+        hub,
+        beams: vec![],
+        plates: vec![wing],
+        masses: vec![],
+        basis: flexcraft::basis::BasisKind::Legendre,
+    })
+    .unwrap();
+    assert_eq!(built, parsed.structure);
+    let omegas = |s: &Structure| {
+        let m = flexcraft::ModalAnalysis::compute(&flexcraft::RitzModel::assemble(s)).unwrap();
+        m.modes.iter().map(|m| m.omega_rad_s).collect::<Vec<_>>()
+    };
+    assert_eq!(omegas(&built), omegas(&parsed.structure));
+    // A refused value names its field.
+    let e = Material::new(70e9, 0.5, 2700.0, None).unwrap_err();
+    assert_eq!(e.field(), Field::PoissonRatio);
+}
