@@ -4,13 +4,13 @@
 mod atomic;
 mod deploy;
 pub mod figures;
-#[cfg(test)]
-mod hostile_names_test;
 mod modes;
 mod names;
 pub(crate) mod plot;
 mod report;
 mod simulate;
+#[cfg(test)]
+mod tests;
 
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, write_deploy};

@@ -2,32 +2,11 @@
 //! reason, exit status 2, and no output left behind; good input writes complete, reproducible
 //! outputs.
 
+use super::common::{bin, entries, scratch};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 const SEED: &str = include_str!("../../examples/seed.toml");
 const FULL: &str = include_str!("../../examples/full.toml");
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_flexcraft"))
-}
-
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexcraft-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
 
 /// Runs `flexcraft SUB SCENARIO --out DIR/a` and `… DIR/b`; returns both stdouts.
 fn run_twice(sub: &str, scenario: &Path, dir: &Path) -> Vec<String> {

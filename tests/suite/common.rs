@@ -113,3 +113,33 @@ pub fn det4(m: [[f64; 4]; 4]) -> f64 {
         .map(|c| if c % 2 == 0 { 1.0 } else { -1.0 } * m[0][c] * minor(0, c))
         .sum()
 }
+
+/// The `flexcraft` binary under test.
+pub fn bin() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_flexcraft"))
+}
+
+/// A bundled example scenario's path.
+pub fn example(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name)
+}
+
+/// A fresh, empty scratch directory for one test (names are unique across the suite).
+pub fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("flexcraft-test-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The sorted names in a directory.
+pub fn entries(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}

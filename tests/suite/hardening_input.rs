@@ -3,25 +3,15 @@
 //! directions and the small-deformation warning. Each refusal is checked through the binary
 //! (file:line:column, key, reason, exit 2, nothing written) or through the library.
 
+use super::common::{bin, scratch};
 use flexcraft::simulation::Simulation;
 use flexcraft::structure::ComponentId;
 use flexcraft::{ModalAnalysis, RitzModel, Scenario};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
 const SEED: &str = include_str!("../../examples/seed.toml");
 const FREE_HUB: &str = include_str!("../../examples/free_hub.toml");
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_flexcraft"))
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexcraft-hin-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Writes `src` as `dir/scenario.toml` and runs `flexcraft SUB it --out dir/out ARGS`.
 fn run(dir: &Path, sub: &str, src: impl AsRef<[u8]>, args: &[&str]) -> Output {

@@ -3,40 +3,13 @@
 //! `--force`), `/` and similar targets, survives concurrent runs and SIGTERM without leftovers;
 //! and stdout write errors are errors, except a closed pipe.
 
+use super::common::{bin, entries, example, scratch};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const SEED: &str = include_str!("../../examples/seed.toml");
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_flexcraft"))
-}
-
-fn example(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples")
-        .join(name)
-}
-
-/// A fresh scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("flexcraft-outdir-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Names in a folder, sorted.
-fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
 
 /// Every file under `root` (relative path → bytes).
 fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {

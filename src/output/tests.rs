@@ -1,7 +1,8 @@
-//! Defence in depth, tested from inside the crate: component names that the scenario
+//! The output layer tested from inside the crate. Defence in depth: component names that the scenario
 //! parser would refuse (it validates them) are forced into a parsed scenario here, and every
 //! output destination must still escape or sanitise them. (Outside the crate a structure is
-//! read-only, so this test can only live here.)
+//! read-only, so this test can only live here.) And long series: decimated for the plots,
+//! complete in the CSV.
 
 use std::path::{Path, PathBuf};
 
@@ -227,5 +228,55 @@ fn hostile_names_are_escaped_for_every_destination() {
     assert_eq!(html.matches("<script>").count(), 1, "one executable script");
     assert!(!html.contains("<!--"));
     assert!(html.contains("&lt;!--&lt;script&gt;"));
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Item 3: a long response is drawn from a few thousand points per curve (its peaks kept),
+/// while response.csv keeps every row.
+#[test]
+fn long_series_are_decimated_for_plots_but_not_for_csv() {
+    let s = scenario_with_components(
+        "[response]\nduration = 30.0\noutput_rate = 1000.0\nmodes = 12\ndamping_ratio = 0.01\n",
+    );
+    let root = scratch("long");
+    let out = root.join("out");
+    let sim = write_simulate(&s, &out);
+    let r = sim.response.as_ref().unwrap();
+    let n = r.history.times.len();
+    assert!(n > 5 * crate::output::figures::PLOT_POINTS, "{n} rows");
+    assert_eq!(csv_rows(&out.join("response.csv")).len(), n + 1);
+
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let mut checked = 0;
+    for b in json_blocks(&html) {
+        let v: serde_json::Value = serde_json::from_str(b).unwrap();
+        let Some(series) = v["series"].as_array() else {
+            continue;
+        };
+        for sr in series {
+            let (x, y) = (sr["x"].as_array().unwrap(), sr["y"].as_array().unwrap());
+            assert!(x.len() <= crate::output::figures::PLOT_POINTS && x.len() == y.len());
+            let xs: Vec<f64> = x.iter().map(|v| v.as_f64().unwrap()).collect();
+            assert!(xs.windows(2).all(|w| w[0] <= w[1]), "x not monotone");
+            // A response channel's peak |value| (summary.json) is in the plotted data.
+            let name = sr["name"].as_str().unwrap();
+            if let Some(c) = r.channels.iter().position(|c| c.label == name) {
+                let peak = r.history.peak(c).0;
+                let drawn = y
+                    .iter()
+                    .map(|v| v.as_f64().unwrap().abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    (drawn - peak).abs() <= 1e-6 * peak,
+                    "{name}: {drawn} vs {peak}"
+                );
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked >= 10, "{checked} channels checked");
+    // The SVG pictures are drawn from the decimated curves too.
+    let svg = std::fs::read_to_string(out.join("plots/response_boom_tip.svg")).unwrap();
+    assert!(svg.len() < 400_000, "{} bytes", svg.len());
     let _ = std::fs::remove_dir_all(&root);
 }
