@@ -19,6 +19,7 @@ use thiserror::Error;
 
 /// Failures of the linear algebra.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum RitzError {
     /// Cholesky of M failed (a massless coordinate or a dependent basis).
     #[error("the mass matrix is not positive definite (first bad pivot at coordinate {pivot})")]
