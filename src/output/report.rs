@@ -254,6 +254,19 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
         st.basis.name(),
         if st.hub.motion == HubMotion::Free { "free" } else { "fixed" }
     );
+    frequency_table(sim, &mut o);
+    if st.hub.motion == HubMotion::Free {
+        hub_fixed_table(sim, &mut o);
+    }
+    mode_shapes(sim, &mut o)?;
+    coefficient_tables(sim, &mut o);
+    o.push_str("</section>\n");
+    Ok(o)
+}
+
+/// The frequency table (first 30 modes): kind, frequency, dominant component, strain-energy
+/// shares and effective masses.
+fn frequency_table(sim: &Simulation, o: &mut String) {
     let comps: Vec<String> = sim
         .modes
         .elastic()
@@ -320,34 +333,38 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
             sim.modes.modes.len() - 30
         );
     }
-    if st.hub.motion == HubMotion::Free {
-        // A free hub's elastic modes carry no base-excitation effective mass; the standard
-        // measure is that of the hub-fixed modes.
-        o.push_str("<h3>Effective masses of the hub-fixed elastic modes</h3><table id=\"effective-masses\"><tr><th>mode</th><th>f [Hz]</th><th>x [kg]</th><th>y [kg]</th><th>z [kg]</th><th>rx [kg·m²]</th><th>ry [kg·m²]</th><th>rz [kg·m²]</th></tr>\n");
-        for (i, m) in sim.modes.hub_fixed.iter().take(12).enumerate() {
-            let _ = write!(
-                o,
-                "<tr><td>{}</td><td>{:.6}</td>",
-                i + 1,
-                m.omega_rad_s / (2.0 * std::f64::consts::PI)
-            );
-            for v in m.effective_mass {
-                let _ = write!(o, "<td>{v:.4e}</td>");
-            }
-            o.push_str("</tr>\n");
-        }
-        let _ = writeln!(
+}
+
+/// A free hub's elastic modes carry no base-excitation effective mass; the standard measure
+/// is that of the hub-fixed modes.
+fn hub_fixed_table(sim: &Simulation, o: &mut String) {
+    o.push_str("<h3>Effective masses of the hub-fixed elastic modes</h3><table id=\"effective-masses\"><tr><th>mode</th><th>f [Hz]</th><th>x [kg]</th><th>y [kg]</th><th>z [kg]</th><th>rx [kg·m²]</th><th>ry [kg·m²]</th><th>rz [kg·m²]</th></tr>\n");
+    for (i, m) in sim.modes.hub_fixed.iter().take(12).enumerate() {
+        let _ = write!(
             o,
-            "</table><p class=\"note\">Appendage rigid mass (the limit of the sums): {}.</p>",
-            sim.modes
-                .appendage_mass
-                .iter()
-                .map(|v| format!("{v:.4e}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            "<tr><td>{}</td><td>{:.6}</td>",
+            i + 1,
+            m.omega_rad_s / (2.0 * std::f64::consts::PI)
         );
+        for v in m.effective_mass {
+            let _ = write!(o, "<td>{v:.4e}</td>");
+        }
+        o.push_str("</tr>\n");
     }
-    // Mode shapes: the first six elastic modes.
+    let _ = writeln!(
+        o,
+        "</table><p class=\"note\">Appendage rigid mass (the limit of the sums): {}.</p>",
+        sim.modes
+            .appendage_mass
+            .iter()
+            .map(|v| format!("{v:.4e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+}
+
+/// Mode shapes: the first six elastic modes.
+fn mode_shapes(sim: &Simulation, o: &mut String) -> Result<(), OutputError> {
     o.push_str("<h3>Mode shapes</h3><p class=\"note\">The first six elastic modes (rigid-body modes are not drawn): grey undeformed, blue deformed (exaggerated).</p><div class=\"modes\">\n");
     for m in sim.modes.elastic().take(6) {
         let svg = mode_shape_svg(&sim.model, m)?;
@@ -358,7 +375,12 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
         );
     }
     o.push_str("</div>\n");
-    // Coefficient tables as the paper's tables 2.2–2.3.
+    Ok(())
+}
+
+/// Coefficient tables of the first two elastic modes, as the paper's tables 2.2–2.3.
+fn coefficient_tables(sim: &Simulation, o: &mut String) {
+    let st = &sim.model.structure;
     o.push_str("<h3>Ritz coefficients of the first two elastic modes (as the paper's tables 2.2–2.3)</h3><p class=\"note\">Mass-normalised shapes. Beams: v_k, w_k bending in the two planes (the paper's d, f), θ_k torsion (c); plates: g_mn (m along the length, n across the width; the width functions include the two rigid ones).</p>\n");
     for m in sim.modes.elastic().take(2) {
         let _ = write!(
@@ -399,8 +421,6 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
         }
         o.push_str("</table>\n");
     }
-    o.push_str("</section>\n");
-    Ok(o)
 }
 
 fn deployment_section(s: &Scenario, sim: &Simulation) -> String {

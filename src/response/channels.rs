@@ -8,9 +8,8 @@
 //! * the hub: translation of its centre of mass along the structure axes (fig. 2.6) and its
 //!   small rotation about them (fig. 2.7).
 
-use crate::ritz::assembly::ElementBasis;
+use crate::ritz::assembly::{ElementKind, FieldKind};
 use crate::ritz::RitzModel;
-use crate::structure::ComponentId;
 
 /// What a channel measures.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -52,25 +51,24 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
     let st = &model.structure;
     let mut out = Vec::new();
     for e in &model.elements {
-        match (&e.id, &e.basis) {
-            (
-                ComponentId::Beam(i),
-                ElementBasis::Beam {
-                    bending, torsion, ..
-                },
-            ) => {
-                let name = &st.beams[*i].name;
+        match &e.basis {
+            ElementKind::Beam {
+                index,
+                bending,
+                torsion,
+                ..
+            } => {
+                let name = &st.beams[*index].name;
                 let xb = bending.eval_vec(1.0);
                 let xt = torsion.eval_vec(1.0);
                 for (field, label, unit, values) in [
-                    (1usize, "v", "m", &xb),
-                    (2, "w", "m", &xb),
-                    (3, "twist", "rad", &xt),
+                    (FieldKind::V, "v", "m", &xb),
+                    (FieldKind::W, "w", "m", &xb),
+                    (FieldKind::Theta, "twist", "rad", &xt),
                 ] {
-                    let f = &e.fields[field];
                     let mut row = vec![0.0; n];
-                    for k in 0..f.len {
-                        row[f.start + k] = values[k][0];
+                    for (k, c) in e.field(field).enumerate() {
+                        row[c] = values[k][0];
                     }
                     out.push(Channel {
                         name: format!("{name}_tip_{label}"),
@@ -85,8 +83,12 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                     });
                 }
             }
-            (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
-                let name = &st.plates[*i].name;
+            ElementKind::Plate {
+                index,
+                length,
+                width,
+            } => {
+                let name = &st.plates[*index].name;
                 let xv = length.eval_vec(1.0);
                 let ny = width.len();
                 let start = e.own_range().start;
@@ -109,7 +111,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                     });
                 }
             }
-            _ => {}
+            ElementKind::Rigid => {}
         }
     }
     // Hub coordinates 0–2 (translation of its centre of mass) and 3–5 (small rotation).

@@ -34,7 +34,7 @@ use crate::basis::{Basis1d, Quadrature};
 use crate::deploy::chain::{Chain, PlanarHub, P2};
 use crate::deploy::{Deployment, DeploymentResult, LatchEvent};
 use crate::math::Vec3;
-use crate::ritz::assembly::{Element, ElementBasis, HUB_DOF};
+use crate::ritz::assembly::{Element, ElementKind, FieldKind, HUB_DOF};
 use crate::ritz::{ModalAnalysis, RitzModel};
 use crate::structure::{ComponentId, HubMotion, Plate, RigidBody, Structure};
 
@@ -124,7 +124,7 @@ impl<'a> PlateView<'a> {
         let element = model
             .element(ComponentId::Plate(idx))
             .ok_or_else(|| ResponseError::UnknownPlate(name.to_string()))?;
-        let ElementBasis::Plate { length, width } = &element.basis else {
+        let ElementKind::Plate { length, width, .. } = &element.basis else {
             return Err(ResponseError::UnknownPlate(name.to_string()));
         };
         Ok(Self {
@@ -275,31 +275,36 @@ pub fn point_impulse(model: &RitzModel, id: ComponentId, local: [f64; 2], s: Vec
         return b;
     };
     let st = &model.structure;
-    let (r, own): (Vec3, Vec<(usize, f64)>) = match (&id, &e.basis) {
-        (
-            ComponentId::Beam(i),
-            ElementBasis::Beam {
-                axial,
-                bending,
-                torsion: _,
-            },
-        ) => {
-            let beam = &st.beams[*i];
+    let (r, own): (Vec3, Vec<(usize, f64)>) = match &e.basis {
+        ElementKind::Beam {
+            index,
+            axial,
+            bending,
+            ..
+        } => {
+            let beam = &st.beams[*index];
             let f = beam.frame;
             let xi = (local[0] / beam.length).clamp(0.0, 1.0);
             let mut own = Vec::new();
             let xa = axial.eval_vec(xi);
             let xb = bending.eval_vec(xi);
-            for (field, comp, vals) in [(0, f.ex, &xa), (1, f.ey, &xb), (2, f.ez, &xb)] {
-                let fr = &e.fields[field];
-                for k in 0..fr.len {
-                    own.push((fr.start + k, vals[k][0] * comp.dot(s)));
+            for (field, comp, vals) in [
+                (FieldKind::U, f.ex, &xa),
+                (FieldKind::V, f.ey, &xb),
+                (FieldKind::W, f.ez, &xb),
+            ] {
+                for (k, c) in e.field(field).enumerate() {
+                    own.push((c, vals[k][0] * comp.dot(s)));
                 }
             }
             (f.ex * local[0], own)
         }
-        (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
-            let p = &st.plates[*i];
+        ElementKind::Plate {
+            index,
+            length,
+            width,
+        } => {
+            let p = &st.plates[*index];
             let xv = length.eval_vec((local[0] / p.length).clamp(0.0, 1.0));
             let yv = width.eval_vec((local[1] / p.width + 0.5).clamp(0.0, 1.0));
             let start = e.own_range().start;
@@ -312,7 +317,7 @@ pub fn point_impulse(model: &RitzModel, id: ComponentId, local: [f64; 2], s: Vec
             }
             (p.length_axis * local[0] + p.width_axis() * local[1], own)
         }
-        _ => (Vec3::ZERO, Vec::new()),
+        ElementKind::Rigid => (Vec3::ZERO, Vec::new()),
     };
     let m = r.cross(s);
     let t = &e.attachment;
@@ -358,124 +363,16 @@ pub fn hand_over(
     let st = &model.structure;
     let chain = &deployment.chain;
     let pl = pre_latch(chain, view.plate, last);
-    let n = model.dof();
-    let c_hub = st.hub.center_of_mass;
     let mut notes = Vec::new();
 
     // Before: the chain's bodies and the rigid rest of the structure.
     let rest = rigid_rest(st, &deployment.plate);
-    let mut before = rigid_momentum(&rest, pl.v_hub, pl.w_hub);
-    let mut energy_before = 0.5 * (pl.v_hub.dot(before.linear) + pl.w_hub.dot(before.angular));
-    let origin = view.element.origin;
-    let ea = view.plate.length_axis;
-    for p in &pl.panels {
-        let centre = origin + ea * (p.start + 0.5 * p.length) - c_hub;
-        let v = p.velocity(0.5 * p.length);
-        before.linear = before.linear + v * p.mass;
-        before.angular = before.angular + centre.cross(v) * p.mass + p.omega * p.inertia;
-        energy_before += 0.5 * (p.mass * v.dot(v) + p.inertia * p.omega.dot(p.omega));
-    }
-
-    let (ea, nn) = (view.plate.length_axis, view.plate.normal);
-    let (a, width, mu) = (
-        view.plate.length,
-        view.plate.width,
-        view.plate.areal_density,
-    );
-    let (nx, ny) = (view.xb.len(), view.yb.len());
-    let mut b = vec![0.0; n];
-    let mut energy_before_field = energy_before;
-    match method {
-        HandoverMethod::Projection => {
-            let mut xv = vec![[0.0; 4]; nx];
-            let mut yv = vec![[0.0; 4]; ny];
-            // q̇_h: the hub's rigid velocity in Ritz coordinates.
-            let mut qh = vec![0.0; n];
-            if st.hub.motion == HubMotion::Free {
-                for i in 0..3 {
-                    qh[i] = pl.v_hub.get(i);
-                    qh[3 + i] = pl.w_hub.get(i);
-                }
-            } else if pl.v_hub.norm() > 0.0 || pl.w_hub.norm() > 0.0 {
-                notes.push(
-                    "the hub is free during deployment but fixed in the structure: its motion at \
-                     the latch is dropped from the hand-over"
-                        .to_string(),
-                );
-            }
-            // ∫Y_n dη, with the width basis's own rule.
-            let yq = view.yb.quadrature();
-            let mut ybar = vec![0.0; ny];
-            for (&eta, &w) in yq.points.iter().zip(&yq.weights) {
-                view.yb.eval_all(eta, &mut yv);
-                for (k, y) in ybar.iter_mut().enumerate() {
-                    *y += w * yv[k][0];
-                }
-            }
-            let xq: Quadrature = view.xb.quadrature();
-            let (mut fu, mut fth) = (Vec3::ZERO, Vec3::ZERO);
-            let mut fg = vec![0.0; nx * ny];
-            let mut ke_delta = 0.0;
-            let rigid = |x: f64| pl.v_hub + pl.w_hub.cross(origin + ea * x - c_hub);
-            for p in &pl.panels {
-                for (&xi, &w) in xq.points.iter().zip(&xq.weights) {
-                    let s = xi * p.length;
-                    let x = p.start + s;
-                    let wt = w * p.length * mu * width;
-                    let dv = p.velocity(s) - rigid(x);
-                    fu = fu + dv * wt;
-                    fth = fth + (ea * x).cross(dv) * wt;
-                    ke_delta += 0.5 * wt * dv.dot(dv);
-                    view.xb.eval_all((x / a).clamp(0.0, 1.0), &mut xv);
-                    let dn = nn.dot(dv) * wt;
-                    for m in 0..nx {
-                        for k in 0..ny {
-                            fg[m * ny + k] += xv[m][0] * ybar[k] * dn;
-                        }
-                    }
-                }
-            }
-            view.scatter(&mut b, fu, fth, &fg);
-            let m = &model.mass;
-            let mut kinetic_h = 0.0;
-            let mut cross = 0.0;
-            for r in 0..n {
-                let mq: f64 = (0..HUB_DOF).map(|c| m[(r, c)] * qh[c]).sum();
-                kinetic_h += 0.5 * qh[r] * mq;
-                cross += qh[r] * b[r];
-                b[r] += mq;
-            }
-            energy_before_field = kinetic_h + cross + ke_delta;
-        }
-        HandoverMethod::Impulse => {
-            let (s, c) = pl.theta.sin_cos();
-            for (i, p) in pl.panels.iter().enumerate() {
-                let sp = last.impulses[i].0;
-                let imp = ea * (c * sp[0] + s * sp[1]) + nn * (-s * sp[0] + c * sp[1]);
-                let bi = point_impulse(
-                    model,
-                    ComponentId::Plate(view.index),
-                    [p.start + 0.5 * p.length, 0.0],
-                    imp,
-                );
-                b.iter_mut().zip(&bi).for_each(|(x, y)| *x += y);
-            }
-        }
-    }
-    let eta_dot = modal_velocities(modal, &b);
-    let mut qdot = vec![0.0; n];
-    for (m, &v) in modal.modes.iter().zip(&eta_dot) {
-        for (q, p) in qdot.iter_mut().zip(&m.shape) {
-            *q += p * v;
-        }
-    }
-    let energy_after = 0.5 * eta_dot.iter().map(|v| v * v).sum::<f64>();
-    let m = &model.mass;
-    let row = |r: usize| (0..n).map(|c| m[(r, c)] * qdot[c]).sum::<f64>();
-    let momentum_after = Momentum {
-        linear: Vec3::new(row(0), row(1), row(2)),
-        angular: Vec3::new(row(3), row(4), row(5)),
+    let (before, energy_before) = momentum_before(&rest, &view, &pl, st.hub.center_of_mass);
+    let (b, energy_before_field) = match method {
+        HandoverMethod::Projection => projected_impulse(model, &view, &pl, &mut notes),
+        HandoverMethod::Impulse => (latch_impulse(model, &view, &pl, last), energy_before),
     };
+    let (eta_dot, qdot, energy_after, momentum_after) = after_latch(model, modal, &b);
     let angle_mismatch = chain
         .hinges
         .iter()
@@ -505,4 +402,158 @@ pub fn hand_over(
         hub_state: pl.hub_state,
         notes,
     })
+}
+
+/// Momentum (about the hub's centre of mass `c_hub`) and kinetic energy just before the latch:
+/// the rigid rest of the structure moving with the hub, plus the deploying panels.
+fn momentum_before(
+    rest: &RigidBody,
+    view: &PlateView<'_>,
+    pl: &PreLatch,
+    c_hub: Vec3,
+) -> (Momentum, f64) {
+    let mut before = rigid_momentum(rest, pl.v_hub, pl.w_hub);
+    let mut energy_before = 0.5 * (pl.v_hub.dot(before.linear) + pl.w_hub.dot(before.angular));
+    let origin = view.element.origin;
+    let ea = view.plate.length_axis;
+    for p in &pl.panels {
+        let centre = origin + ea * (p.start + 0.5 * p.length) - c_hub;
+        let v = p.velocity(0.5 * p.length);
+        before.linear = before.linear + v * p.mass;
+        before.angular = before.angular + centre.cross(v) * p.mass + p.omega * p.inertia;
+        energy_before += 0.5 * (p.mass * v.dot(v) + p.inertia * p.omega.dot(p.omega));
+    }
+    (before, energy_before)
+}
+
+/// The generalized impulse of the projection method: the field's velocity relative to the
+/// hub's rigid motion projected on the plate's functions, plus M q̇_h; with the kinetic energy
+/// of that field before the latch.
+fn projected_impulse(
+    model: &RitzModel,
+    view: &PlateView<'_>,
+    pl: &PreLatch,
+    notes: &mut Vec<String>,
+) -> (Vec<f64>, f64) {
+    let st = &model.structure;
+    let n = model.dof();
+    let c_hub = st.hub.center_of_mass;
+    let origin = view.element.origin;
+    let (ea, nn) = (view.plate.length_axis, view.plate.normal);
+    let (a, width, mu) = (
+        view.plate.length,
+        view.plate.width,
+        view.plate.areal_density,
+    );
+    let (nx, ny) = (view.xb.len(), view.yb.len());
+    let mut b = vec![0.0; n];
+    let mut xv = vec![[0.0; 4]; nx];
+    let mut yv = vec![[0.0; 4]; ny];
+    // q̇_h: the hub's rigid velocity in Ritz coordinates.
+    let mut qh = vec![0.0; n];
+    if st.hub.motion == HubMotion::Free {
+        for i in 0..3 {
+            qh[i] = pl.v_hub.get(i);
+            qh[3 + i] = pl.w_hub.get(i);
+        }
+    } else if pl.v_hub.norm() > 0.0 || pl.w_hub.norm() > 0.0 {
+        notes.push(
+            "the hub is free during deployment but fixed in the structure: its motion at \
+             the latch is dropped from the hand-over"
+                .to_string(),
+        );
+    }
+    // ∫Y_n dη, with the width basis's own rule.
+    let yq = view.yb.quadrature();
+    let mut ybar = vec![0.0; ny];
+    for (&eta, &w) in yq.points.iter().zip(&yq.weights) {
+        view.yb.eval_all(eta, &mut yv);
+        for (k, y) in ybar.iter_mut().enumerate() {
+            *y += w * yv[k][0];
+        }
+    }
+    let xq: Quadrature = view.xb.quadrature();
+    let (mut fu, mut fth) = (Vec3::ZERO, Vec3::ZERO);
+    let mut fg = vec![0.0; nx * ny];
+    let mut ke_delta = 0.0;
+    let rigid = |x: f64| pl.v_hub + pl.w_hub.cross(origin + ea * x - c_hub);
+    for p in &pl.panels {
+        for (&xi, &w) in xq.points.iter().zip(&xq.weights) {
+            let s = xi * p.length;
+            let x = p.start + s;
+            let wt = w * p.length * mu * width;
+            let dv = p.velocity(s) - rigid(x);
+            fu = fu + dv * wt;
+            fth = fth + (ea * x).cross(dv) * wt;
+            ke_delta += 0.5 * wt * dv.dot(dv);
+            view.xb.eval_all((x / a).clamp(0.0, 1.0), &mut xv);
+            let dn = nn.dot(dv) * wt;
+            for m in 0..nx {
+                for k in 0..ny {
+                    fg[m * ny + k] += xv[m][0] * ybar[k] * dn;
+                }
+            }
+        }
+    }
+    view.scatter(&mut b, fu, fth, &fg);
+    let m = &model.mass;
+    let mut kinetic_h = 0.0;
+    let mut cross = 0.0;
+    for r in 0..n {
+        let mq: f64 = (0..HUB_DOF).map(|c| m[(r, c)] * qh[c]).sum();
+        kinetic_h += 0.5 * qh[r] * mq;
+        cross += qh[r] * b[r];
+        b[r] += mq;
+    }
+    (b, kinetic_h + cross + ke_delta)
+}
+
+/// The generalized impulse of the impulse method: the latch impulses applied at the panels'
+/// centres.
+fn latch_impulse(
+    model: &RitzModel,
+    view: &PlateView<'_>,
+    pl: &PreLatch,
+    last: &LatchEvent,
+) -> Vec<f64> {
+    let (ea, nn) = (view.plate.length_axis, view.plate.normal);
+    let mut b = vec![0.0; model.dof()];
+    let (s, c) = pl.theta.sin_cos();
+    for (i, p) in pl.panels.iter().enumerate() {
+        let sp = last.impulses[i].0;
+        let imp = ea * (c * sp[0] + s * sp[1]) + nn * (-s * sp[0] + c * sp[1]);
+        let bi = point_impulse(
+            model,
+            ComponentId::Plate(view.index),
+            [p.start + 0.5 * p.length, 0.0],
+            imp,
+        );
+        b.iter_mut().zip(&bi).for_each(|(x, y)| *x += y);
+    }
+    b
+}
+
+/// The motion after the latch: modal velocities η̇, coordinate velocities q̇, kinetic energy
+/// and momentum.
+fn after_latch(
+    model: &RitzModel,
+    modal: &ModalAnalysis,
+    b: &[f64],
+) -> (Vec<f64>, Vec<f64>, f64, Momentum) {
+    let n = model.dof();
+    let eta_dot = modal_velocities(modal, b);
+    let mut qdot = vec![0.0; n];
+    for (m, &v) in modal.modes.iter().zip(&eta_dot) {
+        for (q, p) in qdot.iter_mut().zip(&m.shape) {
+            *q += p * v;
+        }
+    }
+    let energy_after = 0.5 * eta_dot.iter().map(|v| v * v).sum::<f64>();
+    let m = &model.mass;
+    let row = |r: usize| (0..n).map(|c| m[(r, c)] * qdot[c]).sum::<f64>();
+    let momentum_after = Momentum {
+        linear: Vec3::new(row(0), row(1), row(2)),
+        angular: Vec3::new(row(3), row(4), row(5)),
+    };
+    (eta_dot, qdot, energy_after, momentum_after)
 }

@@ -59,6 +59,7 @@ pub fn rows(duration: f64, rate: f64) -> u64 {
 
 /// Why a response could not be computed.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum ResponseError {
     /// The deployment ended before every hinge latched.
     #[error("the array did not latch completely (hinges {hinges:?} still free at t = {time} s): nothing to hand over")]

@@ -18,10 +18,40 @@ use crate::math::Vec3;
 use crate::structure::{Attachment, Beam, ComponentId, Plate, RigidBody, Structure};
 use faer::Mat;
 
-/// A named field of a component's own coordinates (e.g. the mast's `w`).
+/// Which field of a component's own coordinates a [`FieldRange`] holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FieldKind {
+    /// A beam's axial displacement u.
+    U,
+    /// A beam's bending displacement v (along its e_y).
+    V,
+    /// A beam's bending displacement w (along its e_z).
+    W,
+    /// A beam's torsion angle θ.
+    Theta,
+    /// A plate's deflection coefficients g_mn.
+    G,
+}
+
+impl FieldKind {
+    /// The field's name in outputs: "u", "v", "w", "theta" or "g".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::U => "u",
+            Self::V => "v",
+            Self::W => "w",
+            Self::Theta => "theta",
+            Self::G => "g",
+        }
+    }
+}
+
+/// A field of a component's own coordinates (e.g. the mast's `w`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FieldRange {
-    /// "u", "v", "w", "theta" (beams) or "g" (plates).
+    /// Which field.
+    pub kind: FieldKind,
+    /// The field's name in outputs, always `kind.name()`.
     pub field: &'static str,
     /// First global index.
     pub start: usize,
@@ -29,11 +59,31 @@ pub struct FieldRange {
     pub len: usize,
 }
 
-/// The Ritz functions of one component.
+impl FieldRange {
+    /// The range of `len` coordinates of field `kind` from global index `start`.
+    pub fn new(kind: FieldKind, start: usize, len: usize) -> Self {
+        Self {
+            kind,
+            field: kind.name(),
+            start,
+            len,
+        }
+    }
+
+    /// Global index range.
+    pub fn range(&self) -> std::ops::Range<usize> {
+        self.start..self.start + self.len
+    }
+}
+
+/// The kind of one component together with its Ritz functions: one variant per element kind,
+/// so that the component and its basis cannot disagree.
 #[derive(Debug)]
-pub enum ElementBasis {
+pub enum ElementKind {
     /// A beam: axial, bending (v and w), torsion.
     Beam {
+        /// Index into `Structure::beams`.
+        index: usize,
         /// Axial functions.
         axial: Box<dyn Basis1d>,
         /// Bending functions (shared by v and w).
@@ -43,6 +93,8 @@ pub enum ElementBasis {
     },
     /// A plate: X_m along the length, Y_n across the width.
     Plate {
+        /// Index into `Structure::plates`.
+        index: usize,
         /// Clamped–free functions along the length.
         length: Box<dyn Basis1d>,
         /// Free–free functions across the width.
@@ -52,10 +104,13 @@ pub enum ElementBasis {
     Rigid,
 }
 
+/// The former name of [`ElementKind`].
+pub type ElementBasis = ElementKind;
+
 /// One component's place in the assembled model.
 #[derive(Debug)]
 pub struct Element {
-    /// Which component.
+    /// Which component (agrees with `basis`: both come from one layout entry).
     pub id: ComponentId,
     /// Its own coordinates, field by field.
     pub fields: Vec<FieldRange>,
@@ -63,8 +118,8 @@ pub struct Element {
     pub attachment: Mat<f64>,
     /// Structure-frame position of the attachment point.
     pub origin: Vec3,
-    /// The Ritz functions.
-    pub basis: ElementBasis,
+    /// The component's kind and its Ritz functions.
+    pub basis: ElementKind,
 }
 
 impl Element {
@@ -74,6 +129,95 @@ impl Element {
         let len: usize = self.fields.iter().map(|f| f.len).sum();
         start..start + len
     }
+
+    /// Global index range of one field (empty if the component has no such field).
+    pub fn field(&self, kind: FieldKind) -> std::ops::Range<usize> {
+        self.fields
+            .iter()
+            .find(|f| f.kind == kind)
+            .map_or(0..0, FieldRange::range)
+    }
+}
+
+/// A component's own-coordinate layout before its attachment map is known.
+struct Part<'a> {
+    id: ComponentId,
+    attachment: &'a Attachment,
+    kind: ElementKind,
+    fields: Vec<FieldRange>,
+    /// A lumped mass's inertia (beams and plates take theirs from their element matrices).
+    lumped: Option<RigidBody>,
+}
+
+impl Element {
+    fn new(part: Part<'_>, attachment: Mat<f64>, origin: Vec3) -> Self {
+        Self {
+            id: part.id,
+            fields: part.fields,
+            attachment,
+            origin,
+            basis: part.kind,
+        }
+    }
+}
+
+/// The own-coordinate layout of every component but the hub (beams parents first, then
+/// plates, then lumped masses) and the total number of coordinates.
+fn layout(structure: &Structure) -> (Vec<Part<'_>>, usize) {
+    let kind = structure.basis;
+    let mut n = HUB_DOF;
+    let mut parts = Vec::new();
+    for &i in structure.beam_order() {
+        let beam = &structure.beams[i];
+        let t = beam.terms;
+        let mut fields = Vec::new();
+        for (field, len) in [
+            (FieldKind::U, t.axial),
+            (FieldKind::V, t.bending),
+            (FieldKind::W, t.bending),
+            (FieldKind::Theta, t.torsion),
+        ] {
+            fields.push(FieldRange::new(field, n, len));
+            n += len;
+        }
+        parts.push(Part {
+            id: ComponentId::Beam(i),
+            attachment: &beam.attachment,
+            kind: ElementKind::Beam {
+                index: i,
+                axial: kind.rod(t.axial),
+                bending: kind.bending(t.bending),
+                torsion: kind.rod(t.torsion),
+            },
+            fields,
+            lumped: None,
+        });
+    }
+    for (i, p) in structure.plates.iter().enumerate() {
+        let len = p.terms.dof();
+        parts.push(Part {
+            id: ComponentId::Plate(i),
+            attachment: &p.attachment,
+            kind: ElementKind::Plate {
+                index: i,
+                length: kind.bending(p.terms.length),
+                width: kind.free_free(p.terms.width),
+            },
+            fields: vec![FieldRange::new(FieldKind::G, n, len)],
+            lumped: None,
+        });
+        n += len;
+    }
+    for (i, m) in structure.masses.iter().enumerate() {
+        parts.push(Part {
+            id: ComponentId::Mass(i),
+            attachment: &m.attachment,
+            kind: ElementKind::Rigid,
+            fields: Vec::new(),
+            lumped: Some(m.rigid_body()),
+        });
+    }
+    (parts, n)
 }
 
 /// The assembled Ritz model: K q = ω² M q.
@@ -100,51 +244,8 @@ impl RitzModel {
 
     /// Assembles M and K of a structure with its chosen basis.
     pub fn assemble(structure: &Structure) -> Self {
-        let kind = structure.basis;
         // Own-coordinate layout first, so that every T has its final width.
-        let mut n = HUB_DOF;
-        let mut layout: Vec<(ComponentId, Vec<FieldRange>, ElementBasis)> = Vec::new();
-        for &i in structure.beam_order() {
-            let t = structure.beams[i].terms;
-            let mut fields = Vec::new();
-            for (field, len) in [
-                ("u", t.axial),
-                ("v", t.bending),
-                ("w", t.bending),
-                ("theta", t.torsion),
-            ] {
-                fields.push(FieldRange {
-                    field,
-                    start: n,
-                    len,
-                });
-                n += len;
-            }
-            let basis = ElementBasis::Beam {
-                axial: kind.rod(t.axial),
-                bending: kind.bending(t.bending),
-                torsion: kind.rod(t.torsion),
-            };
-            layout.push((ComponentId::Beam(i), fields, basis));
-        }
-        for (i, p) in structure.plates.iter().enumerate() {
-            let len = p.terms.dof();
-            let fields = vec![FieldRange {
-                field: "g",
-                start: n,
-                len,
-            }];
-            n += len;
-            let basis = ElementBasis::Plate {
-                length: kind.bending(p.terms.length),
-                width: kind.free_free(p.terms.width),
-            };
-            layout.push((ComponentId::Plate(i), fields, basis));
-        }
-        for i in 0..structure.masses.len() {
-            layout.push((ComponentId::Mass(i), Vec::new(), ElementBasis::Rigid));
-        }
-
+        let (parts, n) = layout(structure);
         let mut mass = Mat::<f64>::zeros(n, n);
         let mut stiffness = Mat::<f64>::zeros(n, n);
         let hub = &structure.hub;
@@ -155,18 +256,13 @@ impl RitzModel {
             fields: Vec::new(),
             attachment: hub_t,
             origin: hub.center_of_mass,
-            basis: ElementBasis::Rigid,
+            basis: ElementKind::Rigid,
         }];
         // Root map of every beam, filled in topological order.
         let mut beam_elem: Vec<Option<usize>> = vec![None; structure.beams.len()];
 
-        for (id, fields, basis) in layout {
-            let att = match id {
-                ComponentId::Beam(i) => &structure.beams[i].attachment,
-                ComponentId::Plate(i) => &structure.plates[i].attachment,
-                ComponentId::Mass(i) => &structure.masses[i].attachment,
-                ComponentId::Hub => unreachable!("the hub is not in the layout"),
-            };
+        for part in parts {
+            let att = part.attachment;
             let origin = structure.attachment_point(att);
             let t = match att {
                 Attachment::Hub { point } => hub_map(n, *point, hub.center_of_mass),
@@ -176,42 +272,38 @@ impl RitzModel {
                     section_map(&structure.beams[bi], pe, *station, n)
                 }
             };
-            let own = fields.first().map_or(0, |f| f.start);
-            match (&id, &basis) {
-                (
-                    ComponentId::Beam(i),
-                    ElementBasis::Beam {
-                        axial,
-                        bending,
-                        torsion,
-                    },
-                ) => {
+            let own = part.fields.first().map_or(0, |f| f.start);
+            match &part.kind {
+                ElementKind::Beam {
+                    index,
+                    axial,
+                    bending,
+                    torsion,
+                } => {
                     let (me, ke) = beam_element(
-                        &structure.beams[*i],
+                        &structure.beams[*index],
                         axial.as_ref(),
                         bending.as_ref(),
                         torsion.as_ref(),
                     );
                     add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
-                    beam_elem[*i] = Some(elements.len());
+                    beam_elem[*index] = Some(elements.len());
                 }
-                (ComponentId::Plate(i), ElementBasis::Plate { length, width }) => {
+                ElementKind::Plate {
+                    index,
+                    length,
+                    width,
+                } => {
                     let (me, ke) =
-                        plate_element(&structure.plates[*i], length.as_ref(), width.as_ref());
+                        plate_element(&structure.plates[*index], length.as_ref(), width.as_ref());
                     add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
                 }
-                (ComponentId::Mass(i), _) => {
-                    add_rigid(&mut mass, &t, &structure.masses[*i].rigid_body())
-                }
-                _ => unreachable!("layout pairs ids with their bases"),
+                ElementKind::Rigid => {}
             }
-            elements.push(Element {
-                id,
-                fields,
-                attachment: t,
-                origin,
-                basis,
-            });
+            if let Some(rb) = &part.lumped {
+                add_rigid(&mut mass, &t, rb);
+            }
+            elements.push(Element::new(part, t, origin));
         }
         symmetrize(&mut mass);
         symmetrize(&mut stiffness);
@@ -287,16 +379,7 @@ fn hub_map(n: usize, p: Vec3, c_hub: Vec3) -> Mat<f64> {
 /// T of the section at `station` of a beam: translation
 /// U + Θ × s e_x + u(s) e_x + v(s) e_y + w(s) e_z, rotation Θ + θ(s) e_x − w'(s) e_y + v'(s) e_z.
 fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64> {
-    let ElementBasis::Beam {
-        axial,
-        bending,
-        torsion,
-    } = &parent.basis
-    else {
-        unreachable!("a beam element has a beam basis")
-    };
     let f = beam.frame;
-    let xi = (station / beam.length).clamp(0.0, 1.0);
     let tp = &parent.attachment;
     // Rigid part: [I, −S(s e_x); 0, I] T_parent.
     let s = (f.ex * station).skew();
@@ -310,6 +393,17 @@ fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64
             t[(3 + i, c)] = th.get(i);
         }
     }
+    // Own part (only a beam element has one; its basis comes with it).
+    let ElementKind::Beam {
+        axial,
+        bending,
+        torsion,
+        ..
+    } = &parent.basis
+    else {
+        return t;
+    };
+    let xi = (station / beam.length).clamp(0.0, 1.0);
     let l = beam.length;
     let mut put = |col: usize, tr: Vec3, rot: Vec3| {
         for i in 0..3 {
@@ -317,16 +411,16 @@ fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64
             t[(3 + i, col)] += rot.get(i);
         }
     };
-    let fields = &parent.fields;
+    let field = |kind| parent.field(kind).start;
     for (k, d) in axial.eval_vec(xi).iter().enumerate() {
-        put(fields[0].start + k, f.ex * d[0], Vec3::ZERO);
+        put(field(FieldKind::U) + k, f.ex * d[0], Vec3::ZERO);
     }
     for (k, d) in bending.eval_vec(xi).iter().enumerate() {
-        put(fields[1].start + k, f.ey * d[0], f.ez * (d[1] / l));
-        put(fields[2].start + k, f.ez * d[0], f.ey * (-d[1] / l));
+        put(field(FieldKind::V) + k, f.ey * d[0], f.ez * (d[1] / l));
+        put(field(FieldKind::W) + k, f.ez * d[0], f.ey * (-d[1] / l));
     }
     for (k, d) in torsion.eval_vec(xi).iter().enumerate() {
-        put(fields[3].start + k, Vec3::ZERO, f.ex * d[0]);
+        put(field(FieldKind::Theta) + k, Vec3::ZERO, f.ex * d[0]);
     }
     t
 }

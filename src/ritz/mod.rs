@@ -12,13 +12,14 @@ pub mod eigen;
 pub mod modes;
 pub mod shapes;
 
-pub use assembly::{Element, ElementBasis, FieldRange, RitzModel, HUB_DOF};
+pub use assembly::{Element, ElementBasis, ElementKind, FieldKind, FieldRange, RitzModel, HUB_DOF};
 pub use modes::{HubFixedMode, ModalAnalysis, Mode};
 
 use thiserror::Error;
 
 /// Failures of the linear algebra.
 #[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
 pub enum RitzError {
     /// Cholesky of M failed (a massless coordinate or a dependent basis).
     #[error("the mass matrix is not positive definite (first bad pivot at coordinate {pivot})")]

@@ -1,7 +1,7 @@
 //! Displacement fields of the assembled model: the structure-frame displacement of any point
 //! of a component for a vector of generalized coordinates q (a mode shape or a response).
 
-use super::assembly::{Element, ElementBasis, RitzModel};
+use super::assembly::{Element, ElementKind, FieldKind, RitzModel};
 use crate::math::Vec3;
 use crate::structure::ComponentId;
 
@@ -32,10 +32,11 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
     let Some(e) = model.element(ComponentId::Beam(beam)) else {
         return Vec::new();
     };
-    let ElementBasis::Beam {
+    let ElementKind::Beam {
         axial,
         bending,
         torsion,
+        ..
     } = &e.basis
     else {
         return Vec::new();
@@ -43,7 +44,7 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
     let b = &model.structure.beams[beam];
     let f = b.frame;
     let (u0, th0) = attachment_motion(e, q);
-    let coeff = |k: usize| &q[e.fields[k].start..e.fields[k].start + e.fields[k].len];
+    let coeff = |kind: FieldKind| &q[e.field(kind)];
     (0..n)
         .map(|i| {
             let xi = i as f64 / (n.max(2) - 1) as f64;
@@ -56,12 +57,12 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
                     .map(|(v, ci)| v[d] * ci)
                     .sum()
             };
-            let u = sum(axial.as_ref(), coeff(0), 0);
-            let v = sum(bending.as_ref(), coeff(1), 0);
-            let w = sum(bending.as_ref(), coeff(2), 0);
-            let dv = sum(bending.as_ref(), coeff(1), 1) / b.length;
-            let dw = sum(bending.as_ref(), coeff(2), 1) / b.length;
-            let th = sum(torsion.as_ref(), coeff(3), 0);
+            let u = sum(axial.as_ref(), coeff(FieldKind::U), 0);
+            let v = sum(bending.as_ref(), coeff(FieldKind::V), 0);
+            let w = sum(bending.as_ref(), coeff(FieldKind::W), 0);
+            let dv = sum(bending.as_ref(), coeff(FieldKind::V), 1) / b.length;
+            let dw = sum(bending.as_ref(), coeff(FieldKind::W), 1) / b.length;
+            let th = sum(torsion.as_ref(), coeff(FieldKind::Theta), 0);
             let r = f.ex * x;
             PointSample {
                 local: [x, 0.0],
@@ -84,13 +85,13 @@ pub fn sample_plate(
     let Some(e) = model.element(ComponentId::Plate(plate)) else {
         return Vec::new();
     };
-    let ElementBasis::Plate { length, width } = &e.basis else {
+    let ElementKind::Plate { length, width, .. } = &e.basis else {
         return Vec::new();
     };
     let p = &model.structure.plates[plate];
     let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
     let (u0, th0) = attachment_motion(e, q);
-    let g = &q[e.fields[0].start..e.fields[0].start + e.fields[0].len];
+    let g = &q[e.field(FieldKind::G)];
     let nyb = width.len();
     let mut out = Vec::with_capacity(nx * ny);
     let yv: Vec<Vec<[f64; 4]>> = (0..ny)
