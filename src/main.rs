@@ -1,6 +1,9 @@
 //! `flexcraft`: the command-line layer over the library. It reads files, prints, picks exit
 //! codes; the physics lives in the library.
 
+// No function over 120 lines (clippy.toml), as in the library.
+#![warn(clippy::too_many_lines)]
+
 use clap::{Parser, Subcommand};
 use flexcraft::deploy::Deployment;
 use flexcraft::output::{self, OutputDir};

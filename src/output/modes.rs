@@ -3,7 +3,7 @@
 use super::names::csv_bytes;
 use super::{plot, OutputDir, OutputError};
 use crate::ritz::shapes::{sample_beam, sample_plate, PointSample};
-use crate::ritz::{ElementBasis, ModalAnalysis, Mode, RitzModel};
+use crate::ritz::{ElementKind, ModalAnalysis, Mode, RitzModel};
 use crate::scenario::Scenario;
 use crate::structure::{ComponentId, HubMotion};
 use serde_json::{json, Map, Value};
@@ -94,7 +94,7 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
     let names: Vec<String> = model
         .elements
         .iter()
-        .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
+        .filter(|e| !matches!(e.kind, ElementKind::Rigid))
         .map(|e| st.component_name(e.id).to_string())
         .collect();
     let _ = write!(
@@ -197,7 +197,7 @@ pub fn write_modes(
     let names: Vec<String> = model
         .elements
         .iter()
-        .filter(|e| !matches!(e.basis, ElementBasis::Rigid))
+        .filter(|e| !matches!(e.kind, ElementKind::Rigid))
         .map(|e| st.component_name(e.id).to_string())
         .collect();
     let f = csv_bytes(|w| {
@@ -257,8 +257,8 @@ pub fn write_modes(
             }
             for e in &model.elements {
                 let name = st.component_name(e.id);
-                let ny = match (&e.basis, e.id) {
-                    (ElementBasis::Plate { width, .. }, _) => width.len(),
+                let ny = match (&e.kind, e.id) {
+                    (ElementKind::Plate { width, .. }, _) => width.len(),
                     _ => 0,
                 };
                 for fr in &e.fields {
@@ -268,7 +268,7 @@ pub fn write_modes(
                             (Some(i), Some(j)) => ((i + 1).to_string(), (j + 1).to_string()),
                             _ => ((k + 1).to_string(), String::new()),
                         };
-                        w.write_record([name, fr.field, i.as_str(), j.as_str(), v.as_str()])?;
+                        w.write_record([name, fr.kind.name(), i.as_str(), j.as_str(), v.as_str()])?;
                     }
                 }
             }

@@ -406,7 +406,7 @@ fn coefficient_tables(sim: &Simulation, o: &mut String) {
                     }
                 } else {
                     for k in 0..f.len.min(2) {
-                        cells.push((format!("{}_{}", f.field, k + 1), f.start + k));
+                        cells.push((format!("{}_{}", f.kind.name(), k + 1), f.start + k));
                     }
                 }
             }

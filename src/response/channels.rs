@@ -51,7 +51,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
     let st = &model.structure;
     let mut out = Vec::new();
     for e in &model.elements {
-        match &e.basis {
+        match &e.kind {
             ElementKind::Beam {
                 index,
                 bending,

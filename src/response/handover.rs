@@ -124,7 +124,7 @@ impl<'a> PlateView<'a> {
         let element = model
             .element(ComponentId::Plate(idx))
             .ok_or_else(|| ResponseError::UnknownPlate(name.to_string()))?;
-        let ElementKind::Plate { length, width, .. } = &element.basis else {
+        let ElementKind::Plate { length, width, .. } = &element.kind else {
             return Err(ResponseError::UnknownPlate(name.to_string()));
         };
         Ok(Self {
@@ -275,7 +275,7 @@ pub fn point_impulse(model: &RitzModel, id: ComponentId, local: [f64; 2], s: Vec
         return b;
     };
     let st = &model.structure;
-    let (r, own): (Vec3, Vec<(usize, f64)>) = match &e.basis {
+    let (r, own): (Vec3, Vec<(usize, f64)>) = match &e.kind {
         ElementKind::Beam {
             index,
             axial,

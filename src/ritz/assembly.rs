@@ -51,8 +51,6 @@ impl FieldKind {
 pub struct FieldRange {
     /// Which field.
     pub kind: FieldKind,
-    /// The field's name in outputs, always `kind.name()`.
-    pub field: &'static str,
     /// First global index.
     pub start: usize,
     /// Number of coordinates.
@@ -62,12 +60,7 @@ pub struct FieldRange {
 impl FieldRange {
     /// The range of `len` coordinates of field `kind` from global index `start`.
     pub fn new(kind: FieldKind, start: usize, len: usize) -> Self {
-        Self {
-            kind,
-            field: kind.name(),
-            start,
-            len,
-        }
+        Self { kind, start, len }
     }
 
     /// Global index range.
@@ -104,13 +97,10 @@ pub enum ElementKind {
     Rigid,
 }
 
-/// The former name of [`ElementKind`].
-pub type ElementBasis = ElementKind;
-
 /// One component's place in the assembled model.
 #[derive(Debug)]
 pub struct Element {
-    /// Which component (agrees with `basis`: both come from one layout entry).
+    /// Which component (agrees with `kind`: both come from one layout entry).
     pub id: ComponentId,
     /// Its own coordinates, field by field.
     pub fields: Vec<FieldRange>,
@@ -119,7 +109,7 @@ pub struct Element {
     /// Structure-frame position of the attachment point.
     pub origin: Vec3,
     /// The component's kind and its Ritz functions.
-    pub basis: ElementKind,
+    pub kind: ElementKind,
 }
 
 impl Element {
@@ -156,7 +146,7 @@ impl Element {
             fields: part.fields,
             attachment,
             origin,
-            basis: part.kind,
+            kind: part.kind,
         }
     }
 }
@@ -256,7 +246,7 @@ impl RitzModel {
             fields: Vec::new(),
             attachment: hub_t,
             origin: hub.center_of_mass,
-            basis: ElementKind::Rigid,
+            kind: ElementKind::Rigid,
         }];
         // Root map of every beam, filled in topological order.
         let mut beam_elem: Vec<Option<usize>> = vec![None; structure.beams.len()];
@@ -399,7 +389,7 @@ fn section_map(beam: &Beam, parent: &Element, station: f64, n: usize) -> Mat<f64
         bending,
         torsion,
         ..
-    } = &parent.basis
+    } = &parent.kind
     else {
         return t;
     };

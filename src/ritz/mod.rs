@@ -12,7 +12,7 @@ pub mod eigen;
 pub mod modes;
 pub mod shapes;
 
-pub use assembly::{Element, ElementBasis, ElementKind, FieldKind, FieldRange, RitzModel, HUB_DOF};
+pub use assembly::{Element, ElementKind, FieldKind, FieldRange, RitzModel, HUB_DOF};
 pub use modes::{HubFixedMode, ModalAnalysis, Mode};
 
 use thiserror::Error;

@@ -13,7 +13,7 @@
 //! coordinates (translation of, and rotation about, the hub's centre of mass):
 //! m_eff,i,d = (φ_iᵀ M_e,d)², whose sum over a complete basis is the appendages' rigid mass.
 
-use super::assembly::{ElementBasis, RitzModel, HUB_DOF};
+use super::assembly::{ElementKind, RitzModel, HUB_DOF};
 use super::eigen::generalized_symmetric;
 use super::RitzError;
 use crate::math::Vec3;
@@ -250,7 +250,7 @@ fn strain_energy_shares(model: &RitzModel, modes: &mut [Mode]) {
     let nm = elastic.len();
     let mut energies: Vec<(String, Vec<f64>)> = Vec::new();
     for e in &model.elements {
-        if matches!(e.basis, ElementBasis::Rigid) {
+        if matches!(e.kind, ElementKind::Rigid) {
             continue;
         }
         let r = e.own_range();

@@ -37,7 +37,7 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
         bending,
         torsion,
         ..
-    } = &e.basis
+    } = &e.kind
     else {
         return Vec::new();
     };
@@ -85,7 +85,7 @@ pub fn sample_plate(
     let Some(e) = model.element(ComponentId::Plate(plate)) else {
         return Vec::new();
     };
-    let ElementKind::Plate { length, width, .. } = &e.basis else {
+    let ElementKind::Plate { length, width, .. } = &e.kind else {
         return Vec::new();
     };
     let p = &model.structure.plates[plate];
