@@ -239,7 +239,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
             let name = format!(
                 "mode {} ({:.3} Hz)",
                 m.number,
-                m.omega / (2.0 * std::f64::consts::PI)
+                m.omega_rad_s / (2.0 * std::f64::consts::PI)
             );
             curve(name, n, t, |k| hist.modal[(k, j)])
         })

@@ -61,7 +61,7 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             "elastic_energy_drift": r.history.energy_drift(),
             "kept_modes": r.modal.modes.iter().map(|m| json!({
                 "number": m.number, "rigid": m.rigid,
-                "frequency_hz": m.omega / (2.0 * std::f64::consts::PI),
+                "frequency_hz": m.omega_rad_s / (2.0 * std::f64::consts::PI),
                 "initial_modal_velocity": m.eta_dot0,
             })).collect::<Vec<_>>(),
             "channels": channels,
@@ -158,7 +158,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             o,
             "{:>6} {:>12.6} {:>7} {:>16.6e}",
             m.number,
-            m.omega / (2.0 * std::f64::consts::PI),
+            m.omega_rad_s / (2.0 * std::f64::consts::PI),
             if m.rigid { "yes" } else { "" },
             m.eta_dot0
         );

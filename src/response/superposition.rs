@@ -23,7 +23,7 @@ pub struct KeptMode {
     /// Rigid-body mode.
     pub rigid: bool,
     /// ω, rad/s.
-    pub omega: f64,
+    pub omega_rad_s: f64,
     /// η(0).
     pub eta0: f64,
     /// η̇(0).
@@ -78,7 +78,7 @@ impl ModalResponse {
                 modes.push(KeptMode {
                     number: m.number,
                     rigid: m.rigid,
-                    omega: m.omega_rad_s,
+                    omega_rad_s: m.omega_rad_s,
                     eta0: 0.0,
                     eta_dot0: v,
                 });
@@ -150,13 +150,13 @@ impl ModalResponse {
 /// by the factor e^{−ζωh}; each block starts from the closed form at t = k·h, so rounding
 /// cannot accumulate beyond RESYNC steps (≈ 1e-14 relative).
 fn fill_mode(m: &KeptMode, zeta: f64, h: f64, eta: &mut [f64], energy: &mut [f64]) {
-    if m.rigid || m.omega == 0.0 {
+    if m.rigid || m.omega_rad_s == 0.0 {
         for (k, e) in eta.iter_mut().enumerate() {
             *e = m.eta0 + m.eta_dot0 * (k as f64 * h);
         }
         return;
     }
-    let w = m.omega;
+    let w = m.omega_rad_s;
     let wd = w * (1.0 - zeta * zeta).sqrt();
     let (a, b) = (m.eta0, (m.eta_dot0 + zeta * w * m.eta0) / wd);
     let (sd, cd) = (wd * h).sin_cos();
@@ -181,10 +181,10 @@ fn fill_mode(m: &KeptMode, zeta: f64, h: f64, eta: &mut [f64], energy: &mut [f64
 const RESYNC: usize = 32;
 
 fn state(m: &KeptMode, zeta: f64, t: f64) -> (f64, f64) {
-    if m.rigid || m.omega == 0.0 {
+    if m.rigid || m.omega_rad_s == 0.0 {
         return (m.eta0 + m.eta_dot0 * t, m.eta_dot0);
     }
-    let w = m.omega;
+    let w = m.omega_rad_s;
     let wd = w * (1.0 - zeta * zeta).sqrt();
     let (s, c) = (wd * t).sin_cos();
     let decay = (-zeta * w * t).exp();

@@ -142,7 +142,7 @@ fn damped_response_obeys_the_energy_balance() {
             .filter(|&j| !resp.modes[j].rigid)
             .map(|j| {
                 let (_, ed) = resp.state(j, hist.times[k]);
-                2.0 * zeta * resp.modes[j].omega * ed * ed
+                2.0 * zeta * resp.modes[j].omega_rad_s * ed * ed
             })
             .sum()
     };
@@ -328,7 +328,7 @@ fn seed_response_conserves_energy_and_reports_truncation() {
         if m.rigid {
             m.eta_dot0.abs() * 60.0
         } else {
-            m.eta_dot0.abs() / m.omega
+            m.eta_dot0.abs() / m.omega_rad_s
         }
     };
     let largest = r.modal.modes.iter().map(amplitude).fold(0.0, f64::max);
