@@ -263,17 +263,8 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     let progress = Progress::new(quiet);
     let scenario = load(c)?;
     need_deployment(path, &scenario)?;
-    // The report's footer carries the SHA-256 of the file as read here. The scenario was
-    // parsed by `Scenario::from_file` (size cap, UTF-8 error locations), so the bytes are
-    // read a second time; if that read fails (the file was removed or replaced meanwhile)
-    // the run stops rather than hash nothing.
-    let source = std::fs::read(path).map_err(|e| {
-        eprintln!(
-            "error: {}: reading it again for its SHA-256: {e}",
-            path.display()
-        );
-        ExitCode::from(FAILED)
-    })?;
+    // The report's footer carries the SHA-256 of the text that was parsed (read once).
+    let source = scenario.source_text().as_bytes().to_vec();
     let staged = prepare(out, c.force)?;
     progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| match &e {

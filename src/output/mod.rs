@@ -3,7 +3,7 @@
 
 mod atomic;
 mod deploy;
-pub mod figures;
+pub(crate) mod figures;
 mod modes;
 mod names;
 pub(crate) mod plot;

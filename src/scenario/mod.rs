@@ -45,6 +45,8 @@ pub struct Scenario {
 #[derive(Debug, Clone, Default)]
 struct Sources {
     file: String,
+    /// The text that was parsed.
+    text: String,
     at: BTreeMap<ComponentId, (String, Location)>,
     /// Keys located after parsing (`response.output_rate`, …): the value, or its section.
     keys: BTreeMap<&'static str, Location>,
@@ -68,6 +70,12 @@ impl Scenario {
             key,
             reason: reason.into(),
         }
+    }
+
+    /// The scenario's text exactly as it was parsed (e.g. to fingerprint the run's input
+    /// without reading the file a second time).
+    pub fn source_text(&self) -> &str {
+        &self.sources.text
     }
 
     /// Like [`Scenario::locate`], for one of the keys the run checks after parsing.
@@ -349,6 +357,7 @@ fn sources(cx: &Ctx, raw: &RawScenario) -> Sources {
     }
     Sources {
         file: cx.file.to_string(),
+        text: cx.src.to_string(),
         at,
         keys,
     }
