@@ -2,8 +2,8 @@
 //! reason, exit status 2, and no output left behind; good input writes complete, reproducible
 //! outputs.
 
-use super::common::{bin, entries, scratch};
-use std::path::{Path, PathBuf};
+use super::common::{assert_same_tree, bin, entries, scratch};
+use std::path::Path;
 
 const SEED: &str = include_str!("../../examples/seed.toml");
 const FULL: &str = include_str!("../../examples/full.toml");
@@ -24,29 +24,6 @@ fn run_twice(sub: &str, scenario: &Path, dir: &Path) -> Vec<String> {
             String::from_utf8_lossy(&r.stdout).into_owned()
         })
         .collect()
-}
-
-/// Every file under `a` exists under `b` with the same bytes; returns the number of files.
-fn assert_same_tree(a: &Path, b: &Path) -> usize {
-    fn walk(root: &Path, rel: &Path, out: &mut Vec<PathBuf>) {
-        for e in std::fs::read_dir(root.join(rel)).unwrap() {
-            let e = e.unwrap();
-            let r = rel.join(e.file_name());
-            if e.file_type().unwrap().is_dir() {
-                walk(root, &r, out);
-            } else {
-                out.push(r);
-            }
-        }
-    }
-    let mut files = Vec::new();
-    walk(a, Path::new(""), &mut files);
-    for f in &files {
-        let x = std::fs::read(a.join(f)).unwrap();
-        let y = std::fs::read(b.join(f)).unwrap();
-        assert!(x == y, "{} differs between runs", f.display());
-    }
-    files.len()
 }
 
 /// (name, source, mutation: (from, to), expected location "line:", key fragment, reason fragment)

@@ -143,3 +143,46 @@ pub fn entries(dir: &std::path::Path) -> Vec<String> {
     v.sort();
     v
 }
+
+/// Every file below `root` with its bytes, by path relative to `root`.
+pub fn tree(root: &std::path::Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    use std::path::{Path, PathBuf};
+    fn walk(root: &Path, rel: &Path, out: &mut std::collections::BTreeMap<PathBuf, Vec<u8>>) {
+        for e in std::fs::read_dir(root.join(rel)).unwrap() {
+            let e = e.unwrap();
+            let r = rel.join(e.file_name());
+            if e.file_type().unwrap().is_dir() {
+                walk(root, &r, out);
+            } else {
+                out.insert(r.clone(), std::fs::read(root.join(&r)).unwrap());
+            }
+        }
+    }
+    let mut m = std::collections::BTreeMap::new();
+    walk(root, Path::new(""), &mut m);
+    m
+}
+
+/// The same files with the same bytes under `a` and `b`, both ways (the difference named if
+/// not); returns the number of files.
+pub fn assert_same_tree(a: &std::path::Path, b: &std::path::Path) -> usize {
+    let (x, y) = (tree(a), tree(b));
+    let only_a: Vec<_> = x.keys().filter(|k| !y.contains_key(*k)).collect();
+    let only_b: Vec<_> = y.keys().filter(|k| !x.contains_key(*k)).collect();
+    assert!(
+        only_a.is_empty() && only_b.is_empty(),
+        "only in {}: {only_a:?}; only in {}: {only_b:?}",
+        a.display(),
+        b.display()
+    );
+    for (k, v) in &x {
+        assert!(
+            y[k] == *v,
+            "{} differs between {} and {}",
+            k.display(),
+            a.display(),
+            b.display()
+        );
+    }
+    x.len()
+}

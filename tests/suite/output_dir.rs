@@ -3,47 +3,12 @@
 //! `--force`), `/` and similar targets, survives concurrent runs and SIGTERM without leftovers;
 //! and stdout write errors are errors, except a closed pipe.
 
-use super::common::{bin, entries, example, scratch};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use super::common::{assert_same_tree, bin, entries, example, scratch, tree};
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 const SEED: &str = include_str!("../../examples/seed.toml");
-
-/// Every file under `root` (relative path → bytes).
-fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
-    fn walk(root: &Path, rel: &Path, out: &mut BTreeMap<PathBuf, Vec<u8>>) {
-        for e in std::fs::read_dir(root.join(rel)).unwrap() {
-            let e = e.unwrap();
-            let r = rel.join(e.file_name());
-            if e.file_type().unwrap().is_dir() {
-                walk(root, &r, out);
-            } else {
-                out.insert(r.clone(), std::fs::read(root.join(&r)).unwrap());
-            }
-        }
-    }
-    let mut m = BTreeMap::new();
-    walk(root, Path::new(""), &mut m);
-    m
-}
-
-/// The same files with the same bytes, both ways; the difference named if not.
-fn assert_same_tree(a: &Path, b: &Path) {
-    let (x, y) = (tree(a), tree(b));
-    let only_a: Vec<_> = x.keys().filter(|k| !y.contains_key(*k)).collect();
-    let only_b: Vec<_> = y.keys().filter(|k| !x.contains_key(*k)).collect();
-    assert!(
-        only_a.is_empty() && only_b.is_empty(),
-        "only in {}: {only_a:?}; only in {}: {only_b:?}",
-        a.display(),
-        b.display()
-    );
-    for (k, v) in &x {
-        assert!(y[k] == *v, "{} differs", k.display());
-    }
-}
 
 fn run(args: &[&std::ffi::OsStr]) -> std::process::Output {
     bin().args(args).output().unwrap()
