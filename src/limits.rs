@@ -150,6 +150,14 @@ pub const ANGLE: Limit = closed(
     4.0 * std::f64::consts::PI,
     "rad",
 );
+/// Latch angle of a hinge: (0, π].
+pub const LATCH_ANGLE: Limit = Limit {
+    lo: 0.0,
+    hi: std::f64::consts::PI,
+    open_lo: true,
+    open_hi: false,
+    unit: "rad",
+};
 /// Initial hinge rate.
 pub const RATE: Limit = closed(-100.0, 100.0, "rad/s");
 /// Panel moment of inertia about its hinge-parallel centroidal axis.

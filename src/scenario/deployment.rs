@@ -154,7 +154,7 @@ fn panel_lengths(
             v.clone()
         }
         (None, None) => {
-            return Err(cx.invalid(
+            return Err(cx.missing(
                 raw.span(),
                 "deployment.panels",
                 "missing: give panels or panel_lengths",
@@ -194,24 +194,14 @@ fn hinges(cx: &Ctx, raw: &S<RawDeployment>, n: usize) -> Result<Vec<Hinge>, Scen
             &r.and_then(|h| h.latch_angle.clone()),
             default_latch,
             key("latch_angle"),
-            L::ANGLE,
+            L::LATCH_ANGLE,
         )?;
-        if !(latch > 0.0 && latch <= PI) {
-            let span = r
-                .and_then(|h| h.latch_angle.as_ref())
-                .map_or(raw.span(), |x| x.span());
-            return Err(cx.invalid(
-                span,
-                key("latch_angle"),
-                format!("must lie in (0, π], got {latch}"),
-            ));
-        }
         let stiffness = match r.and_then(|h| h.stiffness.clone()) {
             Some(k) => cx.bounded(&k, key("stiffness"), L::HINGE_STIFFNESS)?,
             None => k_all.ok_or_else(|| {
-                cx.invalid(
+                cx.missing(
                     one.map_or(raw.span(), |h| h.span()),
-                    "deployment.hinge.stiffness",
+                    key("stiffness"),
                     format!("missing: hinge {} has no stiffness (set [deployment.hinge] stiffness or one per hinge)", i + 1),
                 )
             })?,

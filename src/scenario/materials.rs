@@ -14,7 +14,11 @@ pub(super) fn lower(
     let mut out = BTreeMap::new();
     for (name, m) in raw {
         if let Err(why) = crate::limits::valid_name(name) {
-            return Err(cx.invalid(m.span(), "materials", format!("material name: {why}")));
+            return Err(cx.invalid(
+                m.span(),
+                format!("materials.{name}"),
+                format!("material name: {why}"),
+            ));
         }
         let k = format!("materials.{name}");
         let r = m.get_ref();

@@ -53,7 +53,7 @@ pub(super) fn lower(cx: &Ctx, r: &S<RawResponse>) -> Result<ResponseSettings, Sc
     };
     let damping_ratio = match &rr.damping_ratio {
         None => d.damping_ratio,
-        Some(v) if L::DAMPING_RATIO.contains(*v.get_ref()) && *v.get_ref() < 1.0 => *v.get_ref(),
+        Some(v) if L::DAMPING_RATIO.contains(*v.get_ref()) => *v.get_ref(),
         Some(v) => {
             return Err(cx.invalid(
                 v.span(),

@@ -109,11 +109,15 @@ impl Hub {
                 body = body.plus(&RigidBody::from_cm(md, a * (s * (length - wall) / 2.0), j));
             }
         }
+        // The derived body obeys the same ranges as a hub given by its mass properties.
+        let inertia = body.inertia_at_cm();
+        let j = inertia.0;
+        super::inertia_tensor(&[j[0][0], j[1][1], j[2][2], j[0][1], j[0][2], j[1][2]])?;
         Ok(Self {
             motion,
-            mass: body.mass,
+            mass: in_range(Field::Mass, body.mass, L::MASS)?,
             center_of_mass: center,
-            inertia: body.inertia_at_cm(),
+            inertia,
         })
     }
 
@@ -550,11 +554,18 @@ impl Plate {
             } => {
                 let h = in_range(Field::Thickness, thickness, L::SECTION)?;
                 let nu = material.poisson_ratio;
-                (
-                    material.density * h,
-                    material.youngs_modulus * h.powi(3) / (12.0 * (1.0 - nu * nu)),
-                    nu,
-                )
+                // The derived constants obey the ranges of given ones (refused at the
+                // thickness, the value that sets them).
+                let mu = material.density * h;
+                let d = material.youngs_modulus * h.powi(3) / (12.0 * (1.0 - nu * nu));
+                if !(L::AREAL_DENSITY.contains(mu) && L::BENDING_STIFFNESS.contains(d)) {
+                    return Err(StructureError::DerivedOutOfRange {
+                        field: Field::Thickness,
+                        areal_density: mu,
+                        bending_stiffness: d,
+                    });
+                }
+                (mu, d, nu)
             }
             PlateStiffness::Given {
                 areal_density,

@@ -149,6 +149,21 @@ pub enum StructureError {
         /// The accepted range per coordinate.
         range: Limit,
     },
+    /// A plate whose thickness and material give a stiffness or areal density outside the
+    /// ranges accepted for given ones.
+    #[error(
+        "gives ρh = {areal_density:e} kg/m² and D = {bending_stiffness:e} N·m; they must lie in {} and {}",
+        crate::limits::AREAL_DENSITY.describe(),
+        crate::limits::BENDING_STIFFNESS.describe()
+    )]
+    DerivedOutOfRange {
+        /// The field that sets them.
+        field: Field,
+        /// ρh, kg/m².
+        areal_density: f64,
+        /// D, N·m.
+        bending_stiffness: f64,
+    },
     /// A name that breaks the naming rule ([`crate::limits::valid_name`]).
     #[error("{reason}")]
     InvalidName {
@@ -264,7 +279,8 @@ impl StructureError {
             | StructureError::PointOutOfRange { field, .. }
             | StructureError::ZeroAxis { field }
             | StructureError::NotPerpendicular { field, .. }
-            | StructureError::Terms { field, .. } => *field,
+            | StructureError::Terms { field, .. }
+            | StructureError::DerivedOutOfRange { field, .. } => *field,
             StructureError::InvalidName { .. } | StructureError::DuplicateName { .. } => {
                 Field::Name
             }

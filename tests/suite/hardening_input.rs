@@ -372,3 +372,30 @@ fn deflections_beyond_the_linear_model_are_warned_about() {
         .iter()
         .any(|w| w.to_string().contains("small-deformation")));
 }
+
+#[test]
+fn derived_values_obey_the_ranges_of_given_ones() {
+    let dir = scratch("derived");
+    // A 50 m thick aluminium plate: the thickness is a valid section size, but the stiffness
+    // it implies (D ≈ 8e14 N·m) is outside the range accepted for a given D.
+    let full = include_str!("../../examples/full.toml");
+    let src = full.replacen("thickness = 0.01", "thickness = 50.0", 1);
+    let out = run(&dir, "modes", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "thickness = 50.0"),
+        "plates[0].thickness",
+        "D = ",
+    );
+    // A latch angle is refused against its own range, (0, π].
+    let src = FREE_HUB.replacen("stiffness = 9.0", "stiffness = 9.0\nlatch_angle = 5.0", 1);
+    let out = run(&dir, "deploy", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "latch_angle = 5.0"),
+        "deployment.hinges[0].latch_angle",
+        "(0, 3.14",
+    );
+}
