@@ -68,6 +68,25 @@ pub(super) fn lower(
         hinges,
         matches!(d.hub.as_ref().map(|h| *h.get_ref()), Some(RawMotion::Free)),
     );
+    // Panel masses and inertias derived from the plate obey the ranges of given ones.
+    if let Some(p) = chain
+        .panels
+        .iter()
+        .find(|p| !(L::MASS.contains(p.mass) && L::PANEL_INERTIA.contains(p.inertia)))
+    {
+        return Err(cx.invalid(
+            d.plate.span(),
+            "deployment.plate",
+            format!(
+                "a panel of this plate has mass {:e} kg and inertia {:e} kg·m²; they must lie in {} \
+                 and {} (give panel_mass / panel_inertia, or fewer panels)",
+                p.mass,
+                p.inertia,
+                L::MASS.describe(),
+                L::PANEL_INERTIA.describe()
+            ),
+        ));
+    }
     let (end_time, output_rate, tolerance) = run_settings(cx, raw)?;
     Ok(Deployment {
         plate: plate.name.clone(),
@@ -106,7 +125,19 @@ fn panel_lengths(
                     format!("must be between 1 and {}, got {v}", L::MAX_PANELS),
                 ));
             }
-            vec![plate.length / v as f64; v as usize]
+            let l = plate.length / v as f64;
+            if !L::PANEL_LENGTH.contains(l) {
+                return Err(cx.invalid(
+                    n.span(),
+                    "deployment.panels",
+                    format!(
+                        "{v} panels of the {} m plate are {l:e} m long; a panel's length must lie in {}",
+                        plate.length,
+                        L::PANEL_LENGTH.describe()
+                    ),
+                ));
+            }
+            vec![l; v as usize]
         }
         (None, Some(l)) => {
             let v = l.get_ref();

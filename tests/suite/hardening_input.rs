@@ -399,3 +399,32 @@ fn derived_values_obey_the_ranges_of_given_ones() {
         "(0, 3.14",
     );
 }
+
+#[test]
+fn derived_panels_obey_the_ranges_of_given_ones() {
+    let dir = scratch("panels");
+    // A 6 mm wing cut into 100 panels: 6e-5 m panels, shorter than any accepted panel length.
+    let src = FREE_HUB
+        .replacen("length = 6.0", "length = 0.006", 1)
+        .replacen("panels = 3", "panels = 100", 1);
+    let out = run(&dir, "deploy", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "panels = 100"),
+        "deployment.panels",
+        "a panel's length must lie in",
+    );
+    // A feather-light wing: the panel inertia m l²/12 falls below its range.
+    let src = FREE_HUB
+        .replacen("length = 6.0", "length = 0.03", 1)
+        .replacen("areal_density = 5.0", "areal_density = 1e-6", 1);
+    let out = run(&dir, "deploy", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "plate = \"wing\""),
+        "deployment.plate",
+        "give panel_mass",
+    );
+}
