@@ -99,21 +99,26 @@ impl Structure {
             masses,
             basis,
         } = parts;
+        // Every attached component once: its id, name and attachment. ("hub" cannot be a
+        // component's name: the constructors refuse it.)
+        let components = (beams.iter().enumerate())
+            .map(|(i, b)| (ComponentId::Beam(i), &b.name, &b.attachment))
+            .chain(
+                (plates.iter().enumerate())
+                    .map(|(i, p)| (ComponentId::Plate(i), &p.name, &p.attachment)),
+            )
+            .chain(
+                (masses.iter().enumerate())
+                    .map(|(i, m)| (ComponentId::Mass(i), &m.name, &m.attachment)),
+            );
         let mut seen = std::collections::BTreeSet::new();
-        seen.insert("hub".to_string());
-        let names = (beams.iter().enumerate())
-            .map(|(i, b)| (ComponentId::Beam(i), &b.name))
-            .chain((plates.iter().enumerate()).map(|(i, p)| (ComponentId::Plate(i), &p.name)))
-            .chain((masses.iter().enumerate()).map(|(i, m)| (ComponentId::Mass(i), &m.name)));
-        for (component, n) in names {
-            if !seen.insert(n.clone()) {
+        for (component, n, att) in components {
+            if !seen.insert(n) {
                 return Err(StructureError::DuplicateName {
                     component,
                     name: n.clone(),
                 });
             }
-        }
-        let check = |component: ComponentId, att: &Attachment| -> Result<(), StructureError> {
             if let Attachment::Beam { beam, station } = att {
                 let parent = beams.get(*beam).ok_or(StructureError::UnknownParent {
                     component,
@@ -129,16 +134,6 @@ impl Structure {
                     });
                 }
             }
-            Ok(())
-        };
-        for (i, b) in beams.iter().enumerate() {
-            check(ComponentId::Beam(i), &b.attachment)?;
-        }
-        for (i, p) in plates.iter().enumerate() {
-            check(ComponentId::Plate(i), &p.attachment)?;
-        }
-        for (i, m) in masses.iter().enumerate() {
-            check(ComponentId::Mass(i), &m.attachment)?;
         }
         let beam_order = topological_order(&beams)?;
         Ok(Self {
