@@ -4,8 +4,12 @@
 //! structure ([`planar`]), and the run with latch events,
 //! samples, its status and warnings ([`simulate`]).
 
+pub mod attitude;
+pub mod base;
 pub mod chain;
+pub mod coupled;
 pub(crate) mod events;
+pub mod inertia;
 pub(crate) mod integrator;
 pub mod planar;
 pub mod swing;

@@ -6,7 +6,7 @@ use crate::math::Vec3;
 use crate::structure::ComponentId;
 
 /// One sampled point of a component.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct PointSample {
     /// Local coordinates: (x, 0) along a beam, (x, y) on a plate, m.
     pub local: [f64; 2],
@@ -29,9 +29,15 @@ fn attachment_motion(e: &Element, q: &[f64]) -> (Vec3, Vec3) {
 
 /// Samples a beam at `n` equally spaced stations (root and tip included).
 pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<PointSample> {
-    let Some(e) = model.element(ComponentId::Beam(beam)) else {
-        return Vec::new();
-    };
+    (0..n)
+        .filter_map(|i| beam_point(model, beam, i as f64 / (n.max(2) - 1) as f64, q))
+        .collect()
+}
+
+/// The section of beam `beam` at ξ = x/L ∈ [0, 1]: its displacement and small rotation
+/// (twist included) for coordinates q. `None` for a beam the model does not have.
+pub fn beam_point(model: &RitzModel, beam: usize, xi: f64, q: &[f64]) -> Option<PointSample> {
+    let e = model.element(ComponentId::Beam(beam))?;
     let ElementKind::Beam {
         axial,
         bending,
@@ -39,39 +45,40 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
         ..
     } = &e.kind
     else {
-        return Vec::new();
+        return None;
     };
     let b = &model.structure.beams[beam];
     let f = b.frame;
     let (u0, th0) = attachment_motion(e, q);
     let coeff = |kind: FieldKind| &q[e.field(kind)];
-    (0..n)
-        .map(|i| {
-            let xi = i as f64 / (n.max(2) - 1) as f64;
-            let x = xi * b.length;
-            let sum = |basis: &dyn crate::basis::Basis1d, c: &[f64], d: usize| -> f64 {
-                basis
-                    .eval_vec(xi)
-                    .iter()
-                    .zip(c)
-                    .map(|(v, ci)| v[d] * ci)
-                    .sum()
-            };
-            let u = sum(axial.as_ref(), coeff(FieldKind::U), 0);
-            let v = sum(bending.as_ref(), coeff(FieldKind::V), 0);
-            let w = sum(bending.as_ref(), coeff(FieldKind::W), 0);
-            let dv = sum(bending.as_ref(), coeff(FieldKind::V), 1) / b.length;
-            let dw = sum(bending.as_ref(), coeff(FieldKind::W), 1) / b.length;
-            let th = sum(torsion.as_ref(), coeff(FieldKind::Theta), 0);
-            let r = f.ex * x;
-            PointSample {
-                local: [x, 0.0],
-                position: e.origin + r,
-                displacement: u0 + th0.cross(r) + f.ex * u + f.ey * v + f.ez * w,
-                rotation: th0 + f.ex * th - f.ey * dw + f.ez * dv,
-            }
-        })
-        .collect()
+    let x = xi * b.length;
+    let sum = |basis: &dyn crate::basis::Basis1d, c: &[f64], d: usize| -> f64 {
+        basis
+            .eval_vec(xi)
+            .iter()
+            .zip(c)
+            .map(|(v, ci)| v[d] * ci)
+            .sum()
+    };
+    let u = sum(axial.as_ref(), coeff(FieldKind::U), 0);
+    let v = sum(bending.as_ref(), coeff(FieldKind::V), 0);
+    let w = sum(bending.as_ref(), coeff(FieldKind::W), 0);
+    let dv = sum(bending.as_ref(), coeff(FieldKind::V), 1) / b.length;
+    let dw = sum(bending.as_ref(), coeff(FieldKind::W), 1) / b.length;
+    let th = sum(torsion.as_ref(), coeff(FieldKind::Theta), 0);
+    let r = f.ex * x;
+    Some(PointSample {
+        local: [x, 0.0],
+        position: e.origin + r,
+        displacement: u0 + th0.cross(r) + f.ex * u + f.ey * v + f.ez * w,
+        rotation: th0 + f.ex * th - f.ey * dw + f.ez * dv,
+    })
+}
+
+/// The displacement and rotation of the attachment section of a component (the hub's or a
+/// beam section's motion where the component is fixed) for coordinates q.
+pub fn attachment_of(model: &RitzModel, id: ComponentId, q: &[f64]) -> Option<(Vec3, Vec3)> {
+    model.element(id).map(|e| attachment_motion(e, q))
 }
 
 /// Samples a plate on an `nx` × `ny` grid (edges included), row-major in x.
@@ -82,49 +89,53 @@ pub fn sample_plate(
     nx: usize,
     ny: usize,
 ) -> Vec<PointSample> {
-    let Some(e) = model.element(ComponentId::Plate(plate)) else {
-        return Vec::new();
-    };
+    let grid = |i: usize, n: usize| i as f64 / (n.max(2) - 1) as f64;
+    (0..nx)
+        .flat_map(|i| (0..ny).map(move |j| (grid(i, nx), grid(j, ny))))
+        .filter_map(|(xi, eta)| plate_point(model, plate, xi, eta, q))
+        .collect()
+}
+
+/// The point (ξ, η) ∈ [0, 1]² of plate `plate` (ξ along the length from the root edge, η
+/// across the width): its displacement and the small rotation of its normal for
+/// coordinates q. `None` for a plate the model does not have.
+pub fn plate_point(
+    model: &RitzModel,
+    plate: usize,
+    xi: f64,
+    eta: f64,
+    q: &[f64],
+) -> Option<PointSample> {
+    let e = model.element(ComponentId::Plate(plate))?;
     let ElementKind::Plate { length, width, .. } = &e.kind else {
-        return Vec::new();
+        return None;
     };
     let p = &model.structure.plates[plate];
     let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
     let (u0, th0) = attachment_motion(e, q);
     let g = &q[e.field(FieldKind::G)];
     let nyb = width.len();
-    let mut out = Vec::with_capacity(nx * ny);
-    let yv: Vec<Vec<[f64; 4]>> = (0..ny)
-        .map(|j| width.eval_vec(j as f64 / (ny.max(2) - 1) as f64))
-        .collect();
-    for i in 0..nx {
-        let xi = i as f64 / (nx.max(2) - 1) as f64;
-        let xv = length.eval_vec(xi);
-        for (j, yvals) in yv.iter().enumerate() {
-            let eta = j as f64 / (ny.max(2) - 1) as f64;
-            let mut w = 0.0;
-            let (mut wx, mut wy) = (0.0, 0.0);
-            for (m, xm) in xv.iter().enumerate() {
-                for (nidx, yn) in yvals.iter().enumerate() {
-                    let c = g[m * nyb + nidx];
-                    w += c * xm[0] * yn[0];
-                    wx += c * xm[1] * yn[0];
-                    wy += c * xm[0] * yn[1];
-                }
-            }
-            let (x, y) = (xi * p.length, (eta - 0.5) * p.width);
-            let r = ea * x + eb * y;
-            // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
-            let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
-            out.push(PointSample {
-                local: [x, y],
-                position: e.origin + r,
-                displacement: u0 + th0.cross(r) + nn * w,
-                rotation: rot,
-            });
+    let yv = width.eval_vec(eta);
+    let xv = length.eval_vec(xi);
+    let (mut w, mut wx, mut wy) = (0.0, 0.0, 0.0);
+    for (m, xm) in xv.iter().enumerate() {
+        for (nidx, yn) in yv.iter().enumerate() {
+            let c = g[m * nyb + nidx];
+            w += c * xm[0] * yn[0];
+            wx += c * xm[1] * yn[0];
+            wy += c * xm[0] * yn[1];
         }
     }
-    out
+    let (x, y) = (xi * p.length, (eta - 0.5) * p.width);
+    let r = ea * x + eb * y;
+    // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
+    let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
+    Some(PointSample {
+        local: [x, y],
+        position: e.origin + r,
+        displacement: u0 + th0.cross(r) + nn * w,
+        rotation: rot,
+    })
 }
 
 /// Translation of the hub's centre of mass and its small rotation, for q over all

@@ -1,0 +1,219 @@
+//! Inertia invariants of an elastic body in a floating frame (MODEL.md §3.2: "small elastic
+//! deformation in the hub frame, exact rigid motion, all inertia coupling and all
+//! quadratic-velocity terms").
+//!
+//! The body is represented by mass points p (mass m_p, position r_p from the frame's origin O,
+//! displacement Φ_p η, Φ_p a 3×m matrix of the kept modes) and rotary inertias s (tensor I_s,
+//! small rotation Ψ_s η). With v the velocity of O and ω the frame's angular velocity (both
+//! in frame components) every point moves with v + ω × ρ_p + Φ_p η̇, ρ_p = r_p + Φ_p η, so
+//!
+//!   T = ½ m|v|² + v·(ω × s) + v·S η̇ + ½ ωᵀ J ω + ωᵀ L η̇ + ½ η̇ᵀ M_ee η̇,
+//!
+//! with the invariants s(η) = s₀ + S η, J(η) = J₀ + Σ_j η_j J1_j + Σ_jk η_j η_k J2_jk,
+//! L(η) = L₀ + Σ_j η_j L1_j (sums over the points of m_p ρ̃_pᵀρ̃_p, m_p ρ̃_p Φ_p, plus the
+//! rotary inertias' I_s and I_s Ψ_s). The momenta are p = ∂T/∂v = m v + ω × s + S η̇,
+//! h = ∂T/∂ω = s × v + J ω + L η̇, g = ∂T/∂η̇ = Sᵀv + Lᵀω + M_ee η̇, and the equations of
+//! motion (Kirchhoff's for the frame, Lagrange's for η) read
+//!
+//!   ṗ + ω × p = F,   ḣ + ω × h + v × p = M_O,   ġ − ∂T/∂η + K η = Q_η,
+//!
+//! with ∂T/∂η_j = v·(ω × S_j) + ½ ωᵀ J_{,j} ω + ωᵀ L1_j η̇. The rotary inertias keep their
+//! undeformed orientation (their rotation changes I_s at second order in η, neglected: the
+//! torsional and lumped inertias are small). The same invariants of a beam's outboard
+//! subtree give its root loads: F = ṗ + ω × p and M_O = ḣ + ω × h + v × p.
+
+use crate::math::{Mat3, Vec3};
+use faer::Mat;
+
+/// A point mass of the cloud.
+#[derive(Debug, Clone)]
+pub struct MassPoint {
+    /// kg.
+    pub mass: f64,
+    /// Position from the frame's origin, m.
+    pub position: Vec3,
+    /// Displacement per unit modal coordinate, one per mode, m.
+    pub shapes: Vec<Vec3>,
+}
+
+/// A rotary inertia of the cloud (a lumped body's or a beam section's torsional inertia).
+#[derive(Debug, Clone)]
+pub struct RotaryPoint {
+    /// kg·m².
+    pub inertia: Mat3,
+    /// Small rotation per unit modal coordinate, one per mode, rad.
+    pub rotations: Vec<Vec3>,
+}
+
+/// The invariants of a body of `m` modes (see the module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Invariants {
+    /// Number of modes.
+    pub modes: usize,
+    /// kg.
+    pub mass: f64,
+    /// s₀, kg·m.
+    pub s0: Vec3,
+    /// Columns S_j, kg.
+    pub s: Vec<Vec3>,
+    /// J₀, kg·m².
+    pub j0: Mat3,
+    /// J1_j, kg·m.
+    pub j1: Vec<Mat3>,
+    /// J2_jk (index j·m + k), kg.
+    pub j2: Vec<Mat3>,
+    /// Columns of L₀, kg·m.
+    pub l0: Vec<Vec3>,
+    /// L1_j's columns (index j·m + k), kg.
+    pub l1: Vec<Vec3>,
+    /// M_ee (m × m), kg.
+    pub mee: Mat<f64>,
+}
+
+/// The η-dependent invariants at one η.
+#[derive(Debug, Clone)]
+pub struct AtShape {
+    /// s(η).
+    pub s: Vec3,
+    /// J(η).
+    pub j: Mat3,
+    /// Columns of L(η).
+    pub l: Vec<Vec3>,
+    /// ∂J/∂η_j.
+    pub dj: Vec<Mat3>,
+}
+
+fn skew_t_skew(a: Vec3, b: Vec3) -> Mat3 {
+    // ãᵀ b̃ = (a·b) I − b aᵀ.
+    Mat3::IDENTITY * a.dot(b) - b.outer(a)
+}
+
+impl Invariants {
+    /// Sums the invariants of a cloud of `modes` modes.
+    pub fn of_cloud(modes: usize, points: &[MassPoint], rotary: &[RotaryPoint]) -> Self {
+        let m = modes;
+        let mut inv = Self {
+            modes: m,
+            mass: 0.0,
+            s0: Vec3::ZERO,
+            s: vec![Vec3::ZERO; m],
+            j0: Mat3::ZERO,
+            j1: vec![Mat3::ZERO; m],
+            j2: vec![Mat3::ZERO; m * m],
+            l0: vec![Vec3::ZERO; m],
+            l1: vec![Vec3::ZERO; m * m],
+            mee: Mat::zeros(m, m),
+        };
+        for p in points {
+            let (mp, r) = (p.mass, p.position);
+            inv.mass += mp;
+            inv.s0 = inv.s0 + r * mp;
+            inv.j0 = inv.j0 + skew_t_skew(r, r) * mp;
+            for j in 0..m {
+                let fj = p.shapes[j];
+                inv.s[j] = inv.s[j] + fj * mp;
+                inv.j1[j] = inv.j1[j] + (skew_t_skew(r, fj) + skew_t_skew(fj, r)) * mp;
+                inv.l0[j] = inv.l0[j] + r.cross(fj) * mp;
+                for k in 0..m {
+                    let fk = p.shapes[k];
+                    inv.j2[j * m + k] = inv.j2[j * m + k] + skew_t_skew(fj, fk) * mp;
+                    inv.l1[j * m + k] = inv.l1[j * m + k] + fj.cross(fk) * mp;
+                    inv.mee[(j, k)] += mp * fj.dot(fk);
+                }
+            }
+        }
+        for s in rotary {
+            inv.j0 = inv.j0 + s.inertia;
+            for j in 0..m {
+                inv.l0[j] = inv.l0[j] + s.inertia.apply(s.rotations[j]);
+                for k in 0..m {
+                    inv.mee[(j, k)] += s.rotations[j].dot(s.inertia.apply(s.rotations[k]));
+                }
+            }
+        }
+        inv
+    }
+
+    /// s(η), J(η), L(η) and ∂J/∂η.
+    pub fn at(&self, eta: &[f64]) -> AtShape {
+        let m = self.modes;
+        let mut s = self.s0;
+        let mut j = self.j0;
+        let mut l = self.l0.clone();
+        let mut dj = self.j1.clone();
+        for a in 0..m {
+            s = s + self.s[a] * eta[a];
+            j = j + self.j1[a] * eta[a];
+            for b in 0..m {
+                let jab = self.j2[a * m + b];
+                j = j + jab * (eta[a] * eta[b]);
+                dj[a] = dj[a] + (jab + jab.transpose()) * eta[b];
+                l[b] = l[b] + self.l1[a * m + b] * eta[a];
+            }
+        }
+        AtShape { s, j, l, dj }
+    }
+
+    /// L̇ = Σ_j η̇_j L1_j, as columns.
+    pub fn l_rate(&self, eta_dot: &[f64]) -> Vec<Vec3> {
+        let m = self.modes;
+        let mut out = vec![Vec3::ZERO; m];
+        for a in 0..m {
+            for b in 0..m {
+                out[b] = out[b] + self.l1[a * m + b] * eta_dot[a];
+            }
+        }
+        out
+    }
+
+    /// S η̇.
+    pub fn s_rate(&self, eta_dot: &[f64]) -> Vec3 {
+        combine(&self.s, eta_dot)
+    }
+
+    /// The momenta p = m v + ω × s + S η̇ and h = s × v + J ω + L η̇ (frame components).
+    pub fn momenta(&self, at: &AtShape, v: Vec3, w: Vec3, eta_dot: &[f64]) -> (Vec3, Vec3) {
+        let p = v * self.mass + w.cross(at.s) + self.s_rate(eta_dot);
+        let h = at.s.cross(v) + at.j.apply(w) + combine(&at.l, eta_dot);
+        (p, h)
+    }
+
+    /// The rates ṗ + ω × p and ḣ + ω × h + v × p: the force and the moment about O that
+    /// act on the body (frame components), for accelerations (v̇, ω̇, η̈).
+    #[allow(clippy::too_many_arguments)]
+    pub fn wrench(
+        &self,
+        at: &AtShape,
+        v: Vec3,
+        w: Vec3,
+        eta_dot: &[f64],
+        v_dot: Vec3,
+        w_dot: Vec3,
+        eta_ddot: &[f64],
+    ) -> (Vec3, Vec3) {
+        let (p, h) = self.momenta(at, v, w, eta_dot);
+        let s_dot = self.s_rate(eta_dot);
+        let j_dot = at
+            .dj
+            .iter()
+            .zip(eta_dot)
+            .fold(Mat3::ZERO, |acc, (d, e)| acc + *d * *e);
+        let l_dot = self.l_rate(eta_dot);
+        let p_dot = v_dot * self.mass + w_dot.cross(at.s) + w.cross(s_dot) + self.s_rate(eta_ddot);
+        let h_dot = s_dot.cross(v)
+            + at.s.cross(v_dot)
+            + j_dot.apply(w)
+            + at.j.apply(w_dot)
+            + combine(&l_dot, eta_dot)
+            + combine(&at.l, eta_ddot);
+        (p_dot + w.cross(p), h_dot + w.cross(h) + v.cross(p))
+    }
+}
+
+/// Σ_j c_j x_j.
+pub fn combine(columns: &[Vec3], x: &[f64]) -> Vec3 {
+    columns
+        .iter()
+        .zip(x)
+        .fold(Vec3::ZERO, |acc, (c, xi)| acc + *c * *xi)
+}

@@ -1,0 +1,132 @@
+//! The coupled deployment (MODEL.md §3.2: the array on the flexible, free-floating base as one
+//! system) against independent truths: the planar chain of `deploy::chain` in the rigid
+//! limit, and conservation laws on an elastic base.
+
+use flexcraft::deploy::base::{panel_inertia, BaseKind, BaseModel};
+use flexcraft::deploy::chain::{Chain, PlanarHub};
+use flexcraft::deploy::coupled::{Coupled, Synchronisation};
+use flexcraft::deploy::simulate;
+use flexcraft::scenario::Scenario;
+
+fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
+    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    let src = edit(std::fs::read_to_string(&path).unwrap());
+    Scenario::from_toml_str(&src, &path).unwrap()
+}
+
+fn coupled(sc: &Scenario, kind: BaseKind) -> Coupled {
+    let d = sc.deployment.as_ref().unwrap();
+    let st = &sc.structure;
+    let plate = st
+        .plates()
+        .iter()
+        .position(|p| p.name() == d.plate)
+        .unwrap();
+    let width = st.plates()[plate].width();
+    let chain = Chain {
+        hub: PlanarHub::Fixed,
+        root: [0.0, 0.0],
+        ..d.chain.clone()
+    };
+    let panel = chain
+        .panels
+        .iter()
+        .map(|p| panel_inertia(p.mass, width, p.inertia))
+        .collect();
+    Coupled {
+        base: BaseModel::new(st, plate, kind).unwrap(),
+        chain,
+        panel_inertia: panel,
+        sync: Synchronisation::None,
+    }
+}
+
+/// A hub-only base (no beams) is the rigid planar problem: the coupled model's latch times
+/// and rates equal the planar chain's (held and free hub; the wing's root lies in the hub's
+/// principal plane, so the free hub's motion stays planar).
+#[test]
+fn hub_only_base_reproduces_the_planar_chain() {
+    for motion in ["free", "fixed"] {
+        let sc = scenario("free_hub.toml", |s| {
+            s.replace("motion = \"free\"", &format!("motion = \"{motion}\""))
+                .replace("hub = \"free\"", &format!("hub = \"{motion}\""))
+        });
+        let d = sc.deployment.as_ref().unwrap();
+        let planar = simulate(d);
+        let c = coupled(&sc, BaseKind::Flexible { modes: None });
+        assert_eq!(c.modes(), 0);
+        let run = c.simulate(false, d.end_time, d.tolerance);
+        assert_eq!(run.latches.len(), planar.latches.len(), "{motion}");
+        for (a, b) in run.latches.iter().zip(&planar.latches) {
+            assert_eq!(a.hinge, b.hinge);
+            assert!(
+                (a.time - b.time).abs() <= 1e-9 * b.time,
+                "{motion}: latch {} at {} vs planar {}",
+                a.hinge,
+                a.time,
+                b.time
+            );
+            for (x, y) in a.rates_after.iter().zip(&b.rates_after) {
+                assert!((x - y).abs() <= 1e-8, "{motion}: rate {x} vs {y}");
+            }
+        }
+    }
+}
+
+/// Free hub, elastic mast, no damping: linear and angular momentum stay zero (the system
+/// starts at rest) from release through every latch, energy (kinetic + hinge springs +
+/// elastic) is constant between latches, and each latch loses ½ Δuᵀ M Δu.
+#[test]
+fn elastic_base_conserves_momentum_and_energy_and_latches_lose_the_metric_energy() {
+    let sc = scenario("seed.toml", |s| {
+        s.replace("hub = \"fixed\"", "hub = \"free\"")
+            .replace("end_time = 300.0", "end_time = 150.0")
+    });
+    let d = sc.deployment.as_ref().unwrap();
+    let c = coupled(&sc, BaseKind::Flexible { modes: Some(6) });
+    assert_eq!(c.modes(), 6);
+    let run = c.simulate(false, d.end_time, 1e-11);
+    assert!(run.all_latched, "the seed's wing latches within 150 s");
+    let energy = |y: &[f64]| c.kinetic_energy(y) + c.spring_energy(y) + c.elastic_energy(y);
+    let e0 = energy(&c.initial_state());
+    // Largest panel momentum as the scale.
+    let scale = run
+        .latches
+        .iter()
+        .map(|l| {
+            l.rates_before
+                .iter()
+                .zip(&c.chain.panels)
+                .map(|(r, p)| (r * p.length * p.mass).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    let mut prev_after = e0;
+    for l in &run.latches {
+        let (p, ang, _) = c.momentum(&l.state_before);
+        assert!(
+            p.norm() <= 1e-9 * scale,
+            "linear momentum {p:?} (scale {scale})"
+        );
+        assert!(
+            ang.norm() <= 1e-9 * scale * 30.0,
+            "angular momentum {ang:?}"
+        );
+        let e_before = energy(&l.state_before);
+        assert!(
+            (e_before - prev_after).abs() <= 1e-8 * e0,
+            "energy between latches {prev_after} → {e_before}"
+        );
+        let loss = l.energy_before - l.energy_after;
+        assert!(loss >= 0.0);
+        assert!(
+            (loss - l.loss_metric).abs() <= 1e-9 * e0,
+            "latch {}: loss {loss} vs ½ΔuᵀMΔu {}",
+            l.hinge,
+            l.loss_metric
+        );
+        prev_after = e_before - loss;
+    }
+    let (p, ang, _) = c.momentum(&run.final_state);
+    assert!(p.norm() <= 1e-9 * scale && ang.norm() <= 3e-8 * scale);
+}
