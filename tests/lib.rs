@@ -8,6 +8,7 @@ mod suite {
     pub mod beam_functions;
     pub mod cli;
     pub mod common;
+    pub mod coupled_maximal;
     pub mod deploy;
     pub mod deploy_maximal;
     pub mod exact_beams;
