@@ -243,3 +243,68 @@ fn coupled_model_agrees_with_the_maximal_coordinate_formulation() {
         }
     }
 }
+
+/// Ideal cable synchronisation, held hub, N identical panels: one degree of freedom β = α₁
+/// (α_i = 2β for i ≥ 2). Panel k (1-based) then points at ±(π/2 − β) and its centre sits at
+/// ((k − ½) l sin β, ½ l cos β), so T = ½ J(β) β̇² with
+///   J(β) = m l² Σ_k [(k − ½)² cos²β + ¼ sin²β] + N I,
+/// V(β) = ½ k₁(α_ref,1 − β)² + Σ_{i≥2} ½ k_i(α_ref,i − 2β)², and from rest the latch (β = π/2)
+/// comes at t = ∫₀^{π/2} dβ / √(2 (V(0) − V(β)) / J(β)) (with β = s² to remove the
+/// endpoint singularity, Gauss–Legendre in s). Every hinge latches at that one instant.
+#[test]
+fn ideal_cable_latch_time_equals_the_energy_quadrature() {
+    let sc = scenario("free_hub.toml", |s| {
+        s.replace("motion = \"free\"", "motion = \"fixed\"")
+            .replace("hub = \"free\"", "hub = \"fixed\"")
+            .replace("damping = 0.05", "damping = 0.0")
+    });
+    let mut c = coupled(&sc, BaseKind::Rigid);
+    c.sync = Synchronisation::IdealCable;
+    let ch = &c.chain;
+    let n = ch.len() as f64;
+    let (l, m, i0) = (ch.panels[0].length, ch.panels[0].mass, ch.panels[0].inertia);
+    let j = |b: f64| {
+        let (sb, cb) = b.sin_cos();
+        m * l
+            * l
+            * (1..=ch.len())
+                .map(|k| (k as f64 - 0.5).powi(2) * cb * cb + 0.25 * sb * sb)
+                .sum::<f64>()
+            + n * i0
+    };
+    let v = |b: f64| {
+        ch.hinges
+            .iter()
+            .enumerate()
+            .map(|(i, h)| {
+                let a = if i == 0 { b } else { 2.0 * b };
+                0.5 * h.stiffness * (h.reference_angle - a).powi(2)
+            })
+            .sum::<f64>()
+    };
+    let smax = (std::f64::consts::FRAC_PI_2).sqrt();
+    let quad = flexcraft::basis::Quadrature::gauss(200);
+    let t_exact: f64 = quad
+        .points
+        .iter()
+        .zip(&quad.weights)
+        .map(|(x, w)| {
+            let s = x * smax;
+            let b = s * s;
+            w * smax * 2.0 * s / (2.0 * (v(0.0) - v(b)) / j(b)).sqrt()
+        })
+        .sum();
+    let run = c.simulate(false, 120.0, 1e-12);
+    assert_eq!(run.latches.len(), 1, "one latch event locks every hinge");
+    assert!(run.all_latched);
+    let t = run.latches[0].time;
+    assert!(
+        (t - t_exact).abs() <= 1e-8 * t_exact,
+        "cable latch at {t} s, quadrature {t_exact} s"
+    );
+    // Every hinge at its latch angle at that instant: straight.
+    let s = c.view(&run.latches[0].state_before);
+    for (a, h) in s.alpha.iter().zip(&ch.hinges) {
+        assert!((a - h.latch_angle).abs() < 1e-9, "{a} vs {}", h.latch_angle);
+    }
+}
