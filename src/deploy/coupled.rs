@@ -706,22 +706,11 @@ impl Coupled {
         let ev = self.evaluate(y);
         let s = self.view(y);
         let inv = &self.base.invariants;
-        let (mut p, mut h) = inv.momenta(&ev.at, s.v, s.w, s.eta_dot);
-        let mut first = ev.at.s;
-        let mut mass = inv.mass;
-        for (i, (r, v, w)) in self.panel_motion(y, &ev).into_iter().enumerate() {
-            let mi = self.chain.panels[i].mass;
-            let [i1, i2, i3] = self.panel_inertia[i];
-            let (sn, cs) = ev.phi[i].sin_cos();
-            let a1 = ev.frame.apply(Vec3::new(cs, sn, 0.0));
-            let a2 = ev.frame.apply(Vec3::new(-sn, cs, 0.0));
-            let a3 = col(ev.frame, 2);
-            let ii = a1.outer(a1) * i1 + a2.outer(a2) * i2 + a3.outer(a3) * i3;
-            p = p + v * mi;
-            h = h + r.cross(v * mi) + ii.apply(w);
-            first = first + r * mi;
-            mass += mi;
-        }
+        let (pb, hb) = inv.momenta(&ev.at, s.v, s.w, s.eta_dot);
+        let panels = self.panel_momenta(y, &ev, Vec3::ZERO);
+        let (p, h) = (pb + panels.linear, hb + panels.angular);
+        let first = ev.at.s + panels.first_moment;
+        let mass = inv.mass + panels.mass;
         let a = attitude::matrix(s.quat);
         let pi = a.apply(p);
         let cm = s.r + a.apply(first * (1.0 / mass));
@@ -753,6 +742,14 @@ impl Coupled {
         }
         dy[np..].copy_from_slice(&udot);
     }
+}
+
+#[derive(Default)]
+struct PanelMomenta {
+    linear: Vec3,
+    angular: Vec3,
+    first_moment: Vec3,
+    mass: f64,
 }
 
 struct ChainBlocks {
@@ -866,8 +863,15 @@ impl Coupled {
     /// The chain's linear and angular momentum about the root hinge point (hub components).
     fn chain_momentum(&self, y: &[f64]) -> (Vec3, Vec3) {
         let ev = self.evaluate(y);
-        let (mut p, mut h) = (Vec3::ZERO, Vec3::ZERO);
-        for (i, (r, v, w)) in self.panel_motion(y, &ev).into_iter().enumerate() {
+        let m = self.panel_momenta(y, &ev, ev.hinge);
+        (m.linear, m.angular)
+    }
+
+    /// The panels' momenta (hub components): linear, angular about `about` (from the hub's
+    /// centre of mass), and their first moment about the hub's centre of mass and mass.
+    fn panel_momenta(&self, y: &[f64], ev: &Eval, about: Vec3) -> PanelMomenta {
+        let mut out = PanelMomenta::default();
+        for (i, (r, v, w)) in self.panel_motion(y, ev).into_iter().enumerate() {
             let mi = self.chain.panels[i].mass;
             let [i1, i2, i3] = self.panel_inertia[i];
             let (sn, cs) = ev.phi[i].sin_cos();
@@ -875,10 +879,12 @@ impl Coupled {
             let a2 = ev.frame.apply(Vec3::new(-sn, cs, 0.0));
             let a3 = col(ev.frame, 2);
             let ii = a1.outer(a1) * i1 + a2.outer(a2) * i2 + a3.outer(a3) * i3;
-            p = p + v * mi;
-            h = h + (r - ev.hinge).cross(v * mi) + ii.apply(w);
+            out.linear = out.linear + v * mi;
+            out.angular = out.angular + (r - about).cross(v * mi) + ii.apply(w);
+            out.first_moment = out.first_moment + r * mi;
+            out.mass += mi;
         }
-        (p, h)
+        out
     }
 
     /// Runs from release until every hinge has latched or `end_time`, with sequential or
