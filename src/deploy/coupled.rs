@@ -565,11 +565,16 @@ impl Coupled {
     /// Accelerations for the hinges flagged free, and the loads.
     pub fn solve(&self, y: &[f64], free: &[bool]) -> (Eval, Solution) {
         let ev = self.evaluate(y);
-        let z = self.admissible(free);
-        let rhs: Vec<f64> = ev.force.iter().zip(&ev.bias).map(|(f, c)| f - c).collect();
-        let udot = solve_admissible(&ev.mass, &z, &rhs);
+        let udot = self.accelerations(&ev, free);
         let sol = self.loads(y, &ev, udot, free);
         (ev, sol)
+    }
+
+    /// u̇ on the admissible speeds of the hinges flagged free: (ZᵀMZ) ẇ = Zᵀ(Q − c), u̇ = Z ẇ.
+    fn accelerations(&self, ev: &Eval, free: &[bool]) -> Vec<f64> {
+        let z = self.admissible(free);
+        let rhs: Vec<f64> = ev.force.iter().zip(&ev.bias).map(|(f, c)| f - c).collect();
+        solve_admissible(&ev.mass, &z, &rhs)
     }
 
     /// The root wrench and cable torques for accelerations u̇.
@@ -721,10 +726,7 @@ impl Coupled {
 
     /// dy/dt for the hinges flagged free.
     pub fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
-        let ev = self.evaluate(y);
-        let z = self.admissible(free);
-        let rhs: Vec<f64> = ev.force.iter().zip(&ev.bias).map(|(f, c)| f - c).collect();
-        let udot = solve_admissible(&ev.mass, &z, &rhs);
+        let udot = self.accelerations(&self.evaluate(y), free);
         let s = self.view(y);
         let np = self.positions();
         let (h, m) = (self.hub_dof(), self.modes());
