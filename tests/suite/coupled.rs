@@ -14,7 +14,8 @@ fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
     Scenario::from_toml_str(&src, &path).unwrap()
 }
 
-fn coupled(sc: &Scenario, kind: BaseKind) -> Coupled {
+/// The coupled model of a scenario's deployment (hub motion from `[hub] motion`, no cable).
+pub fn coupled(sc: &Scenario, kind: BaseKind) -> Coupled {
     let d = sc.deployment.as_ref().unwrap();
     let st = &sc.structure;
     let plate = st
