@@ -9,6 +9,7 @@ mod suite {
     pub mod cli;
     pub mod common;
     pub mod coupled;
+    pub mod coupled_limits;
     pub mod coupled_maximal;
     pub mod deploy;
     pub mod deploy_maximal;
