@@ -15,7 +15,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .as_ref()
         .ok_or("the scenario has no [deployment] section")?;
 
-    let result = flexcraft::deploy::simulate(deployment);
+    let (_model, result) = flexcraft::deploy::simulate_coupled(&scenario.structure, deployment)?;
 
     println!("{}: {} latch events", scenario.name, result.latches.len());
     for e in &result.latches {

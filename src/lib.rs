@@ -84,8 +84,10 @@
 //! ## Deployment and its latch events
 //!
 //! The `[deployment]` section of a scenario is [`Scenario::deployment`];
-//! [`deploy::simulate`] integrates it and returns a [`deploy::DeploymentResult`] with the
-//! sampled motion and one [`deploy::LatchEvent`] per latching.
+//! [`deploy::simulate_coupled`] integrates it on the flexible, free-floating spacecraft as
+//! one system and returns the coupled model and a [`deploy::DeploymentResult`] with the
+//! sampled motion and one [`deploy::LatchEvent`] per latching ([`deploy::simulate`] runs
+//! the planar chain alone, the rigid reference).
 //!
 //! ```
 //! use flexcraft::Scenario;
@@ -93,7 +95,7 @@
 //! let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed.toml");
 //! let scenario = Scenario::from_file(path.as_ref())?;
 //! let deployment = scenario.deployment.as_ref().expect("seed.toml has a [deployment]");
-//! let result = flexcraft::deploy::simulate(deployment);
+//! let (_model, result) = flexcraft::deploy::simulate_coupled(&scenario.structure, deployment)?;
 //! for e in &result.latches {
 //!     println!(
 //!         "t = {:.3} s: hinge {} latched, kinetic energy {:.4e} J -> {:.4e} J",

@@ -158,6 +158,14 @@ pub const LATCH_ANGLE: Limit = Limit {
     open_hi: false,
     unit: "rad",
 };
+/// Torsional stiffness of a cable loop between neighbouring hinges.
+pub const CABLE_STIFFNESS: Limit = Limit {
+    lo: 0.0,
+    hi: 1e9,
+    open_lo: true,
+    open_hi: false,
+    unit: "N·m/rad",
+};
 /// Initial hinge rate.
 pub const RATE: Limit = closed(-100.0, 100.0, "rad/s");
 /// Panel moment of inertia about its hinge-parallel centroidal axis.

@@ -245,14 +245,18 @@ fn run_deploy(c: &Common) -> Result<(), ExitCode> {
     let scenario = load(c)?;
     let d = need_deployment(path, &scenario)?;
     let staged = prepare(out, c.force)?;
-    let result = flexcraft::deploy::simulate(d);
+    let (coupled, result) =
+        flexcraft::deploy::simulate_coupled(&scenario.structure, d).map_err(|e| {
+            eprintln!("error: {}: {e}", path.display());
+            ExitCode::from(FAILED)
+        })?;
     not_finite(path, flexcraft::finite::check_deployment(&result))?;
     finish(
         json,
-        || output::deploy_json(&scenario.name, d, &result),
-        || output::deploy_table(&scenario.name, d, &result),
+        || output::deploy_json(&scenario.name, d, &coupled, &result),
+        || output::deploy_table(&scenario.name, d, &coupled, &result),
         staged.zip(out),
-        |o| output::write_deploy(o, &scenario.name, d, &result),
+        |o| output::write_deploy(o, &scenario.name, d, &coupled, &result),
     )
 }
 

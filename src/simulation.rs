@@ -2,11 +2,11 @@
 //! deployment, the hand-over at the final latch and the latch-excited response
 //! (MODEL.md §3; the paper's section 2).
 
-use crate::deploy::{self, DeploymentResult};
+use crate::deploy::coupled::Coupled;
+use crate::deploy::{self, DeployError, DeploymentResult};
 use crate::response::channels::standard_channels;
-use crate::response::{
-    hand_over, Channel, Handover, ModalResponse, ResponseError, ResponseHistory,
-};
+use crate::response::handover::hand_over_coupled;
+use crate::response::{Channel, Handover, ModalResponse, ResponseError, ResponseHistory};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
 use crate::scenario::Scenario;
 use crate::warning::Warning;
@@ -21,6 +21,9 @@ pub enum SimulationError {
     /// The modal analysis failed.
     #[error(transparent)]
     Ritz(#[from] RitzError),
+    /// The coupled deployment model could not be built.
+    #[error(transparent)]
+    Deploy(#[from] DeployError),
     /// The hand-over failed for a reason other than an incomplete deployment.
     #[error(transparent)]
     Response(#[from] ResponseError),
@@ -46,6 +49,8 @@ pub struct Simulation {
     pub model: RitzModel,
     /// Its modes.
     pub modes: ModalAnalysis,
+    /// The coupled deployment model (base modes, beams, chain).
+    pub coupled: Coupled,
     /// The deployment.
     pub deployment: DeploymentResult,
     /// The response, when every hinge latched.
@@ -95,9 +100,10 @@ impl Simulation {
         let settings = &scenario.response;
         let model = RitzModel::assemble(&scenario.structure);
         let modes = ModalAnalysis::compute(&model)?;
-        let deployment = deploy::simulate(d);
+        let (coupled, deployment) = deploy::simulate_coupled(&scenario.structure, d)?;
         let mut warnings = Vec::new();
-        let response = match hand_over(&model, &modes, d, &deployment, settings.handover) {
+        let handed = hand_over_coupled(&model, &modes, d, &coupled, &deployment, settings.handover);
+        let response = match handed {
             Ok(handover) => {
                 warnings.extend(handover.notes.iter().cloned().map(Warning::HandoverNote));
                 if handover.angle_mismatch > 1e-9 {
@@ -105,7 +111,12 @@ impl Simulation {
                         rad: handover.angle_mismatch,
                     });
                 }
-                let modal = ModalResponse::new(&modes, &handover.modal_velocity, settings);
+                let modal = ModalResponse::with_initial(
+                    &modes,
+                    &handover.modal_displacement,
+                    &handover.modal_velocity,
+                    settings,
+                );
                 if let Some(req) = settings.modes {
                     if req > modal.available_elastic {
                         warnings.push(Warning::ModesClamped {
@@ -133,6 +144,7 @@ impl Simulation {
         Ok(Self {
             model,
             modes,
+            coupled,
             deployment,
             response,
             warnings,

@@ -46,6 +46,24 @@ pub enum Warning {
         /// Elastic modes of the model.
         available: usize,
     },
+    /// Simultaneous latching without a cable locked the array bent at `t`.
+    LocksBent {
+        /// Time of the lock, s.
+        t: f64,
+        /// The hinge farthest from its latch angle (1-based).
+        hinge: usize,
+        /// Its latch angle minus its angle, rad.
+        rad: f64,
+    },
+    /// `[deployment] base_modes` was 0 or above the base's count: clamped.
+    BaseModesClamped {
+        /// `deployment.base_modes`.
+        requested: usize,
+        /// Modes kept.
+        kept: usize,
+        /// The base's hub-fixed modes.
+        available: usize,
+    },
     /// The array locked away from the straight wing; the hand-over uses the straight wing.
     AngleMismatch {
         /// Largest hinge-angle mismatch, rad.
@@ -115,6 +133,28 @@ impl fmt::Display for Warning {
                 f,
                 "response.modes = {requested} but the model has {available} elastic modes: all \
                  of them are kept"
+            ),
+            Self::LocksBent { t, hinge, rad } => write!(
+                f,
+                "LATCHING = \"simultaneous\" WITHOUT A CABLE LOCKS THE ARRAY BENT: at t = {t} s \
+                 every hinge locked where it stood; hinge {hinge} is {rad:.6} rad ({:.1}°) short \
+                 of its latch angle. Hinges tied by cables reach their latch angles together: \
+                 use [deployment] synchronisation = \"cable\"",
+                rad.to_degrees()
+            ),
+            Self::BaseModesClamped {
+                requested,
+                kept,
+                available,
+            } => write!(
+                f,
+                "deployment.base_modes = {requested} is outside 1…{available} (the base's \
+                 hub-fixed modes): {kept} kept{}",
+                if *requested == 0 {
+                    " (a rigid base is base = \"rigid\")"
+                } else {
+                    ""
+                }
             ),
             Self::AngleMismatch { rad } => write!(
                 f,

@@ -127,14 +127,13 @@ pub struct Solution {
     pub root_wrench: (Vec3, Vec3),
     /// Cable torque per loop, N·m (empty without a cable).
     pub cable_torque: Vec<f64>,
+    /// The root hinge frame's acceleration and angular acceleration and the hinges' α̈:
+    /// [A; Ω̇; α̈], hinge components.
+    pub hinge_acc: Vec<f64>,
 }
 
 fn cross_mat(a: Vec3) -> Mat3 {
     a.skew()
-}
-
-fn col(m: Mat3, j: usize) -> Vec3 {
-    Vec3::new(m.get(0, j), m.get(1, j), m.get(2, j))
 }
 
 fn from_cols(c: [Vec3; 3]) -> Mat3 {
@@ -341,30 +340,40 @@ impl Coupled {
         let mut bias = vec![0.0; ns];
         self.base_terms(&s, &at, &mut mass, &mut bias);
         let mc = &chain.mc;
-        // [B 0; 0 I]ᵀ M_c [B 0; 0 I].
-        let mut g = Mat::zeros(6 + n, ns);
-        for i in 0..6 {
+        // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B, Bᵀ M₁₂, M₂₁ B, M₂₂ (loops: the
+        // blocks are small, and a general product's set-up costs more than the arithmetic).
+        let mut mb = vec![0.0; (6 + n) * nb]; // M_c[:, 0..6] B, row-major (6 + n) × nb
+        for i in 0..6 + n {
             for j in 0..nb {
-                g[(i, j)] = b[(i, j)];
+                mb[i * nb + j] = (0..6).map(|k| mc[(i, k)] * b[(k, j)]).sum::<f64>();
             }
         }
-        for i in 0..n {
-            g[(6 + i, nb + i)] = 1.0;
-        }
-        let mcg = mc * &g;
-        let gt_mcg = g.transpose() * &mcg;
-        for i in 0..ns {
-            for j in 0..ns {
-                mass[(i, j)] += gt_mcg[(i, j)];
+        for i in 0..nb {
+            for j in 0..nb {
+                mass[(i, j)] += (0..6).map(|k| b[(k, i)] * mb[k * nb + j]).sum::<f64>();
+            }
+            for c in 0..n {
+                // Bᵀ M₁₂ = (M₂₁ B)ᵀ.
+                let v = mb[(6 + c) * nb + i];
+                mass[(i, nb + c)] += v;
+                mass[(nb + c, i)] += v;
             }
         }
-        // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0].
+        for r in 0..n {
+            for c in 0..n {
+                mass[(nb + r, nb + c)] += mc[(6 + r, 6 + c)];
+            }
+        }
+        // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ.
         let mut cb = chain.bc.clone();
         for i in 0..6 + n {
             cb[i] += (0..6).map(|k| mc[(i, k)] * a_bias[k]).sum::<f64>();
         }
-        for j in 0..ns {
-            bias[j] += (0..6 + n).map(|i| g[(i, j)] * cb[i]).sum::<f64>();
+        for j in 0..nb {
+            bias[j] += (0..6).map(|i| b[(i, j)] * cb[i]).sum::<f64>();
+        }
+        for c in 0..n {
+            bias[nb + c] += cb[6 + c];
         }
         // Applied forces.
         let mut force = vec![0.0; ns];
@@ -484,11 +493,7 @@ impl Coupled {
         let mut cdd = Vec::with_capacity(n);
         let (mut vh, mut ah) = (Vec3::ZERO, Vec3::ZERO);
         for i in 0..n {
-            let (sn, cs) = cfg.phi[i].sin_cos();
-            let a1 = Vec3::new(cs, sn, 0.0);
-            let a2 = Vec3::new(-sn, cs, 0.0);
-            let [i1, i2, i3] = self.panel_inertia[i];
-            inertia.push(a1.outer(a1) * i1 + a2.outer(a2) * i2 + z.outer(z) * i3);
+            inertia.push(self.panel_tensor(i, cfg.phi[i]));
             let r = centres[i] - hinges[i];
             let l = hinges[i + 1] - hinges[i];
             let wi = rates[i];
@@ -562,6 +567,16 @@ impl Coupled {
         }
     }
 
+    /// Panel i's inertia tensor about its centre in hinge components, at absolute angle φ_i.
+    pub(crate) fn panel_tensor(&self, i: usize, phi: f64) -> Mat3 {
+        let z = Vec3::new(0.0, 0.0, 1.0);
+        let (sn, cs) = phi.sin_cos();
+        let a1 = Vec3::new(cs, sn, 0.0);
+        let a2 = Vec3::new(-sn, cs, 0.0);
+        let [i1, i2, i3] = self.panel_inertia[i];
+        a1.outer(a1) * i1 + a2.outer(a2) * i2 + z.outer(z) * i3
+    }
+
     /// Accelerations for the hinges flagged free, and the loads.
     pub fn solve(&self, y: &[f64], free: &[bool]) -> (Eval, Solution) {
         let ev = self.evaluate(y);
@@ -621,6 +636,7 @@ impl Coupled {
             udot,
             root_wrench: (f, mo),
             cable_torque,
+            hinge_acc: acc,
         }
     }
 
@@ -722,6 +738,16 @@ impl Coupled {
         // About the inertial origin: R × P + A h; about the centre of mass: minus c × P.
         let l = s.r.cross(pi) + a.apply(h) - cm.cross(pi);
         (pi, l, cm)
+    }
+
+    /// Linear momentum (N·s) and angular momentum about the hub's centre of mass (N·m·s),
+    /// hub components.
+    pub fn momentum_hub(&self, y: &[f64]) -> (Vec3, Vec3) {
+        let ev = self.evaluate(y);
+        let s = self.view(y);
+        let (pb, hb) = self.base.invariants.momenta(&ev.at, s.v, s.w, s.eta_dot);
+        let panels = self.panel_momenta(y, &ev, Vec3::ZERO);
+        (pb + panels.linear, hb + panels.angular)
     }
 
     /// dy/dt for the hinges flagged free.
@@ -846,24 +872,13 @@ pub struct CoupledRun {
     pub final_state: Vec<f64>,
     /// Every hinge locked.
     pub all_latched: bool,
-    /// Accepted steps.
+    /// Right-hand-side evaluations.
     pub steps: usize,
-}
-
-struct CoupledSystem<'a> {
-    model: &'a Coupled,
-    free: Vec<bool>,
-}
-
-impl super::integrator::OdeSystem for CoupledSystem<'_> {
-    fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        self.model.rhs(y, &self.free, dy);
-    }
 }
 
 impl Coupled {
     /// The chain's linear and angular momentum about the root hinge point (hub components).
-    fn chain_momentum(&self, y: &[f64]) -> (Vec3, Vec3) {
+    pub(crate) fn chain_momentum(&self, y: &[f64]) -> (Vec3, Vec3) {
         let ev = self.evaluate(y);
         let m = self.panel_momenta(y, &ev, ev.hinge);
         (m.linear, m.angular)
@@ -875,12 +890,11 @@ impl Coupled {
         let mut out = PanelMomenta::default();
         for (i, (r, v, w)) in self.panel_motion(y, ev).into_iter().enumerate() {
             let mi = self.chain.panels[i].mass;
-            let [i1, i2, i3] = self.panel_inertia[i];
-            let (sn, cs) = ev.phi[i].sin_cos();
-            let a1 = ev.frame.apply(Vec3::new(cs, sn, 0.0));
-            let a2 = ev.frame.apply(Vec3::new(-sn, cs, 0.0));
-            let a3 = col(ev.frame, 2);
-            let ii = a1.outer(a1) * i1 + a2.outer(a2) * i2 + a3.outer(a3) * i3;
+            // E I_H Eᵀ: the tensor in hub components.
+            let ii = ev
+                .frame
+                .matmul(self.panel_tensor(i, ev.phi[i]))
+                .matmul(ev.frame.transpose());
             out.linear = out.linear + v * mi;
             out.angular = out.angular + (r - about).cross(v * mi) + ii.apply(w);
             out.first_moment = out.first_moment + r * mi;
@@ -890,79 +904,54 @@ impl Coupled {
     }
 
     /// Runs from release until every hinge has latched or `end_time`, with sequential or
-    /// simultaneous latching, at relative tolerance `tol`.
+    /// simultaneous latching, at relative tolerance `tol`, with the explicit integrator (it
+    /// conserves energy to the tolerance; the latches only: the samples, loads and warnings
+    /// are [`super::simulate_coupled`]'s).
     pub fn simulate(&self, simultaneous: bool, end_time: f64, tol: f64) -> CoupledRun {
-        use super::integrator::Dopri5;
-        let n = self.panels();
-        let np = self.positions();
-        let mut sys = CoupledSystem {
-            model: self,
-            free: vec![true; n],
-        };
-        let latch: Vec<f64> = self.chain.hinges.iter().map(|h| h.latch_angle).collect();
-        let mut solver = Dopri5::new(tol, tol * 1e-2, f64::INFINITY);
-        let mut y = self.initial_state();
-        let mut t = 0.0;
-        let mut latches = Vec::new();
-        let mut steps = 0;
-        let off = self.alpha_offset();
-        while t < end_time && sys.free.iter().any(|f| *f) && steps < super::MAX_STEPS {
-            steps += 1;
-            let step = solver.step(&sys, &mut t, &mut y, end_time);
-            if !y.iter().all(|v| v.is_finite()) {
-                break;
-            }
-            let Some(e) = super::events::earliest_latch(&step, off, &latch, &sys.free) else {
-                continue;
-            };
-            step.eval(e.t, &mut y);
-            t = e.t;
-            let mut free_after = sys.free.clone();
-            let locking: Vec<usize> = if simultaneous || self.sync == Synchronisation::IdealCable {
-                (0..n).collect()
+        let settings = super::RunSettings {
+            latching: if simultaneous {
+                super::Latching::Simultaneous
             } else {
-                vec![e.hinge]
-            };
-            for &j in &locking {
-                if sys.free[j] {
-                    free_after[j] = false;
+                super::Latching::Sequential
+            },
+            end_time,
+            output_rate: 1.0 / end_time,
+            tolerance: tol,
+            integrator: super::Integrator::Explicit,
+        };
+        let r = super::run::run(self, &settings, super::MAX_STEPS);
+        let latches = r
+            .latches
+            .into_iter()
+            .map(|e| {
+                let state_before: Vec<f64> = e.q.iter().chain(&e.qd_before).copied().collect();
+                let du: Vec<f64> = e
+                    .qd_before
+                    .iter()
+                    .zip(&e.qd_after)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let mass = self.evaluate(&state_before).mass;
+                let (f, m) = e.base_impulse.unwrap_or_default();
+                CoupledLatch {
+                    hinge: e.hinge,
+                    time: e.time,
+                    rates_before: e.rates_before,
+                    rates_after: e.rates_after,
+                    energy_before: e.energy_before,
+                    energy_after: e.energy_after,
+                    loss_metric: 0.5 * dot(&du, &mat_vec(&mass, &du)),
+                    base_impulse: (Vec3(f), Vec3(m)),
+                    state_before,
                 }
-            }
-            for &j in &locking {
-                if self.sync == Synchronisation::IdealCable || j == e.hinge {
-                    y[off + j] = latch[j];
-                }
-            }
-            let before = y.clone();
-            let (p0, h0) = self.chain_momentum(&y);
-            let energy_before = self.kinetic_energy(&y);
-            let u_new = self.impact(&y, &free_after);
-            let du: Vec<f64> = y[np..].iter().zip(&u_new).map(|(a, b)| a - b).collect();
-            let ev = self.evaluate(&y);
-            let loss_metric = 0.5 * dot(&du, &mat_vec(&ev.mass, &du));
-            y[np..].copy_from_slice(&u_new);
-            let (p1, h1) = self.chain_momentum(&y);
-            let ro = self.rate_offset();
-            latches.push(CoupledLatch {
-                hinge: e.hinge + 1,
-                time: e.t,
-                rates_before: before[np + ro..].to_vec(),
-                rates_after: u_new[ro..].to_vec(),
-                energy_before,
-                energy_after: self.kinetic_energy(&y),
-                loss_metric,
-                base_impulse: (p0 - p1, h0 - h1),
-                state_before: before,
-            });
-            sys.free = free_after;
-            solver.restart();
-        }
+            })
+            .collect();
         CoupledRun {
             latches,
-            final_time: t,
-            final_state: y,
-            all_latched: !sys.free.iter().any(|f| *f),
-            steps,
+            final_time: r.final_time,
+            final_state: r.final_q.iter().chain(&r.final_qd).copied().collect(),
+            all_latched: r.all_latched,
+            steps: r.evaluations,
         }
     }
 }

@@ -75,6 +75,11 @@ pub struct DenseStep {
 }
 
 impl DenseStep {
+    /// The extension y(s) = r0 + s (r1 + (1 − s)(r2 + s (r3 + (1 − s) r4))), s = (t − t0)/h.
+    pub(crate) fn from_coefficients(t0: f64, h: f64, r: [Vec<f64>; 5]) -> Self {
+        Self { t0, h, r }
+    }
+
     /// End of the step.
     pub fn t1(&self) -> f64 {
         self.t0 + self.h

@@ -11,15 +11,31 @@ pub mod coupled;
 pub(crate) mod events;
 pub mod inertia;
 pub(crate) mod integrator;
+pub mod loads;
 pub mod planar;
+pub(crate) mod rosenbrock;
+mod run;
 pub mod swing;
 
+use crate::ritz::RitzError;
+use crate::structure::Structure;
 use crate::warning::Warning;
-use chain::{Chain, P2};
-use events::Crossing;
-use integrator::{DenseStep, Dopri5, OdeSystem};
+use base::{BaseKind, BaseModel};
+use chain::{Chain, PlanarHub, P2};
+use coupled::{Coupled, Synchronisation};
 pub use swing::SwingBack;
-use swing::SwingTracker;
+
+/// Why a coupled deployment could not be built.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DeployError {
+    /// The deploying plate is not in the structure.
+    #[error("the structure has no plate named \"{0}\"")]
+    UnknownPlate(String),
+    /// The base's modal analysis failed.
+    #[error(transparent)]
+    Ritz(#[from] RitzError),
+}
 
 /// When hinges lock.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,6 +61,70 @@ pub struct Deployment {
     pub output_rate: f64,
     /// Relative integration tolerance.
     pub tolerance: f64,
+    /// The base during deployment: flexible (its hub-fixed modes) or frozen rigid.
+    pub base: BaseKind,
+    /// How the hinges are tied.
+    pub synchronisation: Synchronisation,
+    /// The time integrator.
+    pub integrator: Integrator,
+}
+
+/// The time integrator of a deployment run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Integrator {
+    /// DOPRI5, explicit Runge–Kutta 5(4) (the default): cheap steps that conserve energy to
+    /// the tolerance, bound by the highest kept base mode (h < 3.3/ω_max) when that mode is
+    /// stiff.
+    #[default]
+    Explicit,
+    /// Rodas5P, L-stable Rosenbrock of order 5: steps set by the resolved motion whatever the
+    /// highest mode (unresolved modes are damped numerically); a Jacobian per step.
+    Implicit,
+}
+
+/// What a run needs besides the model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunSettings {
+    /// Latching mode.
+    pub latching: Latching,
+    /// Stop time, s.
+    pub end_time: f64,
+    /// Sample rate, Hz: samples at t = k / output_rate.
+    pub output_rate: f64,
+    /// Relative integration tolerance.
+    pub tolerance: f64,
+    /// The time integrator.
+    pub integrator: Integrator,
+}
+
+/// The three-dimensional state of the coupled model at a sample (hub and base quantities;
+/// inertial components unless stated).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct BodySample {
+    /// Hub centre of mass position, m.
+    pub hub_position: [f64; 3],
+    /// Hub attitude as a rotation vector, rad.
+    pub hub_rotation: [f64; 3],
+    /// Hub centre of mass velocity, m/s.
+    pub hub_velocity: [f64; 3],
+    /// Hub angular velocity, rad/s.
+    pub hub_rate: [f64; 3],
+    /// Base modal coordinates (hub-fixed modes, mass-normalised), √kg·m.
+    pub eta: Vec<f64>,
+    /// Per base beam: elastic tip deflection along the beam's axes (u axial, v, w) in m and
+    /// twist in rad, relative to the hub.
+    pub beam_tips: Vec<[f64; 4]>,
+    /// Per base beam: the force (N) and moment about the root point (N·m) that the parent
+    /// exerts on the beam, hub components.
+    pub root_loads: Vec<[f64; 6]>,
+    /// Cable torque per loop (ideal cable: the constraint's multiplier), N·m.
+    pub cable_torque: Vec<f64>,
+    /// Elastic energy of the base, J.
+    pub elastic: f64,
+    /// Total linear momentum, N·s.
+    pub momentum: [f64; 3],
+    /// Total angular momentum about the system's centre of mass, N·m·s.
+    pub angular_momentum: [f64; 3],
 }
 
 /// One output sample.
@@ -70,6 +150,8 @@ pub struct Sample {
     pub spring: f64,
     /// Hinge and panel points (for snapshots), m.
     pub hinges: Vec<P2>,
+    /// The coupled model's 3-D state (`None` for the planar chain).
+    pub body: Option<Box<BodySample>>,
 }
 
 /// One latch event.
@@ -91,15 +173,21 @@ pub struct LatchEvent {
     pub energy_before: f64,
     /// Kinetic energy after, J.
     pub energy_after: f64,
-    /// Per hinge: linear impulse from the inboard body on panel i (N·s) and angular impulse
-    /// carried by the hinge (N·m·s).
+    /// Per hinge: linear impulse from the inboard body on panel i (N·s, deployment-plane
+    /// axes) and angular impulse carried by the hinge (N·m·s).
     pub impulses: Vec<(P2, f64)>,
     /// Hub velocity after (u̇, v̇, θ̇) for a free hub.
     pub hub_rate_after: [f64; 3],
-    /// Every coordinate at the event (the chain's q: hub's u, v, θ when free, then α).
+    /// Every coordinate at the event (the chain's q: hub's u, v, θ when free, then α; the
+    /// coupled model's positions).
     pub q: Vec<f64>,
     /// Every rate just before the impact.
     pub qd_before: Vec<f64>,
+    /// Every rate just after the impact.
+    pub qd_after: Vec<f64>,
+    /// The coupled model: the impulse the base receives at the root hinge, hub components:
+    /// force (N·s) and moment about the hinge point (N·m·s).
+    pub base_impulse: Option<([f64; 3], [f64; 3])>,
 }
 
 /// How a deployment run ended.
@@ -169,253 +257,9 @@ impl DeploymentResult {
 /// example takes a few thousand steps.
 pub const MAX_STEPS: usize = 1_000_000;
 
-struct System<'a> {
-    chain: &'a Chain,
-    free: Vec<bool>,
-}
-
-impl OdeSystem for System<'_> {
-    fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        let n = self.chain.dof();
-        let d = self
-            .chain
-            .solve_dynamics(&y[..n], &y[n..], &self.free, false);
-        for i in 0..n {
-            dy[i] = if self.free[i] { y[n + i] } else { 0.0 };
-            dy[n + i] = d.qdd[i];
-        }
-    }
-}
-
-fn sample(chain: &Chain, t: f64, y: &[f64], free: &[bool]) -> Sample {
-    let n = chain.dof();
-    let h = chain.hub_dof();
-    let (q, qd) = (&y[..n], &y[n..]);
-    let d = chain.dynamics(q, qd, free);
-    let hub = if h == 3 { [q[0], q[1], q[2]] } else { [0.0; 3] };
-    let hub_rate = if h == 3 {
-        [qd[0], qd[1], qd[2]]
-    } else {
-        [0.0; 3]
-    };
-    Sample {
-        t,
-        alpha: q[h..].to_vec(),
-        rate: qd[h..].to_vec(),
-        hub,
-        hub_rate,
-        force: d.force,
-        moment: d.moment,
-        kinetic: chain.kinetic_energy(q, qd),
-        spring: chain.spring_energy(q),
-        hinges: chain.configuration(q).hinges,
-    }
-}
-
-/// The impact at latch crossing `e`: `y` holds the state at the crossing; the hinges that
-/// lock (per `latching`) are fixed in `free`, the rates in `y` replaced by those after the
-/// impact. Returns the event.
-fn impact(
-    chain: &Chain,
-    latching: Latching,
-    e: Crossing,
-    y: &mut [f64],
-    free: &mut Vec<bool>,
-) -> LatchEvent {
-    let n = chain.dof();
-    let h = chain.hub_dof();
-    let mut free_after = free.clone();
-    match latching {
-        Latching::Sequential => free_after[h + e.hinge] = false,
-        Latching::Simultaneous => free_after[h..].iter_mut().for_each(|f| *f = false),
-    }
-    let (q, qd) = y.split_at(n);
-    let (qd_new, impulses) = chain.impact(q, qd, &free_after);
-    let locked = (0..chain.len())
-        .filter(|&i| free[h + i] && !free_after[h + i])
-        .map(|i| i + 1)
-        .collect();
-    let event = LatchEvent {
-        hinge: e.hinge + 1,
-        locked,
-        time: e.t,
-        angles: q[h..].to_vec(),
-        rates_before: qd[h..].to_vec(),
-        rates_after: qd_new[h..].to_vec(),
-        energy_before: chain.kinetic_energy(q, qd),
-        energy_after: chain.kinetic_energy(q, &qd_new),
-        impulses,
-        hub_rate_after: if h == 3 {
-            [qd_new[0], qd_new[1], qd_new[2]]
-        } else {
-            [0.0; 3]
-        },
-        q: q.to_vec(),
-        qd_before: qd.to_vec(),
-    };
-    y[n..].copy_from_slice(&qd_new);
-    *free = free_after;
-    event
-}
-
-/// The state of a run between steps.
-struct Run<'a> {
-    d: &'a Deployment,
-    sys: System<'a>,
-    latch_angles: Vec<f64>,
-    solver: Dopri5,
-    t: f64,
-    y: Vec<f64>,
-    samples: Vec<Sample>,
-    next_k: u64,
-    latches: Vec<LatchEvent>,
-    swing: SwingTracker,
-    buf: Vec<f64>,
-}
-
-impl<'a> Run<'a> {
-    fn new(d: &'a Deployment) -> Self {
-        let chain = &d.chain;
-        let n = chain.dof();
-        let (q0, qd0) = chain.initial_state();
-        let y: Vec<f64> = q0.iter().chain(&qd0).copied().collect();
-        let sys = System {
-            chain,
-            free: vec![true; n],
-        };
-        let samples = vec![sample(chain, 0.0, &y, &sys.free)];
-        Self {
-            d,
-            sys,
-            latch_angles: chain.hinges.iter().map(|j| j.latch_angle).collect(),
-            solver: Dopri5::new(d.tolerance, d.tolerance * 1e-2, f64::INFINITY),
-            t: 0.0,
-            y,
-            samples,
-            next_k: 1,
-            latches: Vec::new(),
-            swing: SwingTracker::new(chain.hinges.iter().map(|j| j.initial_angle).collect()),
-            buf: vec![0.0; 2 * n],
-        }
-    }
-
-    /// Some hinge is still free.
-    fn moving(&self) -> bool {
-        self.sys.free[self.sys.chain.hub_dof()..].iter().any(|f| *f)
-    }
-
-    /// One accepted step: its samples, the swing-back scan and the earliest latch in it.
-    /// False (and the state left at the step's start) when the step's state is not finite.
-    fn advance(&mut self) -> bool {
-        let h = self.sys.chain.hub_dof();
-        let n = self.sys.chain.dof();
-        let y_start = self.y.clone();
-        let step = self
-            .solver
-            .step(&self.sys, &mut self.t, &mut self.y, self.d.end_time);
-        if !self.y.iter().all(|v| v.is_finite()) {
-            self.y.copy_from_slice(&y_start);
-            self.t = step.t0;
-            return false;
-        }
-        let event = events::earliest_latch(&step, h, &self.latch_angles, &self.sys.free[h..]);
-        let t_limit = event.map_or(self.t, |e| e.t);
-        self.sample_until(&step, t_limit);
-        self.swing.scan(&step, h, t_limit);
-        match event {
-            None => self.swing.observe(self.t, &self.y[h..n]),
-            Some(e) => self.latch(&step, e),
-        }
-        true
-    }
-
-    /// Samples at k / rate within (step.t0, t_limit].
-    fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
-        let chain = self.sys.chain;
-        let (h, n) = (chain.hub_dof(), chain.dof());
-        loop {
-            let tk = self.next_k as f64 / self.d.output_rate;
-            if tk > t_limit || tk > self.d.end_time {
-                break;
-            }
-            step.eval(tk, &mut self.buf);
-            self.swing.observe(tk, &self.buf[h..n]);
-            self.samples
-                .push(sample(chain, tk, &self.buf, &self.sys.free));
-            self.next_k += 1;
-        }
-    }
-
-    /// The latch at crossing `e` of `step`: the state moves to the crossing, the impact
-    /// applies, and samples just before and after are recorded.
-    fn latch(&mut self, step: &DenseStep, e: Crossing) {
-        let chain = self.sys.chain;
-        let h = chain.hub_dof();
-        step.eval(e.t, &mut self.y);
-        self.y[h + e.hinge] = self.latch_angles[e.hinge];
-        self.t = e.t;
-        let before = sample(chain, e.t, &self.y, &self.sys.free);
-        let event = impact(chain, self.d.latching, e, &mut self.y, &mut self.sys.free);
-        self.latches.push(event);
-        if self.samples.last().is_none_or(|s| s.t < e.t) {
-            self.samples.push(before);
-        }
-        self.samples
-            .push(sample(chain, e.t, &self.y, &self.sys.free));
-        self.solver.restart();
-    }
-
-    fn finish(self, out_of_steps: bool, diverged: bool) -> DeploymentResult {
-        let chain = self.sys.chain;
-        let (h, n) = (chain.hub_dof(), chain.dof());
-        let all_latched = !self.moving();
-        let t = self.t;
-        let status = if diverged {
-            RunStatus::Diverged { t }
-        } else if all_latched {
-            RunStatus::AllLatched
-        } else if out_of_steps && t < self.d.end_time {
-            RunStatus::StepLimit { t }
-        } else {
-            RunStatus::EndTime
-        };
-        let unlatched: Vec<(usize, f64)> = (0..chain.len())
-            .filter(|&i| self.sys.free[h + i])
-            .map(|i| (i + 1, self.y[h + i]))
-            .collect();
-        let (swing_back, mut warnings) = self.swing.finish();
-        match status {
-            RunStatus::Diverged { t } => warnings.push(Warning::Diverged { t }),
-            RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
-            RunStatus::AllLatched | RunStatus::EndTime => {}
-        }
-        if !all_latched {
-            warnings.push(Warning::NotLatched {
-                t,
-                hinges: unlatched
-                    .iter()
-                    .map(|&(i, a)| (i, a, self.latch_angles[i - 1]))
-                    .collect(),
-            });
-        }
-        DeploymentResult {
-            samples: self.samples,
-            latches: self.latches,
-            status,
-            all_latched,
-            final_time: t,
-            final_q: self.y[..n].to_vec(),
-            final_qd: self.y[n..].to_vec(),
-            unlatched,
-            swing_back,
-            warnings,
-            evaluations: self.solver.evaluations,
-        }
-    }
-}
-
-/// Runs the deployment until every hinge has latched or `end_time` (at most [`MAX_STEPS`]
-/// steps).
+/// Runs the planar chain of `d` (hub held, or free with the hub body alone; the rigid
+/// reference of the coupled model) until every hinge has latched or `end_time` (at most
+/// [`MAX_STEPS`] steps).
 pub fn simulate(d: &Deployment) -> DeploymentResult {
     simulate_limited(d, MAX_STEPS)
 }
@@ -423,15 +267,79 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
 /// [`simulate`] with a step limit of the caller's choosing: the run stops after `max_steps`
 /// steps with [`RunStatus::StepLimit`] (and its warning).
 pub fn simulate_limited(d: &Deployment, max_steps: usize) -> DeploymentResult {
-    let mut run = Run::new(d);
-    let mut steps = 0usize;
-    let mut diverged = false;
-    while run.t < d.end_time && run.moving() && steps < max_steps {
-        steps += 1;
-        if !run.advance() {
-            diverged = true;
-            break;
+    run::run(&run::PlanarEngine(&d.chain), &d.settings(), max_steps)
+}
+
+/// The deployment of `d` on the structure `st` as one system ([`coupled`]): the array on the
+/// flexible (or frozen rigid, per `d.base`), free or held base. Returns the coupled model
+/// (for the hand-over) and the run.
+pub fn simulate_coupled(
+    st: &Structure,
+    d: &Deployment,
+) -> Result<(Coupled, DeploymentResult), DeployError> {
+    let c = d.coupled(st)?;
+    let mut r = run::run(&c, &d.settings(), MAX_STEPS);
+    if let BaseKind::Flexible {
+        modes: Some(requested),
+    } = d.base
+    {
+        let available = c.base.ritz.dof().saturating_sub(6);
+        if requested == 0 || requested > available {
+            r.warnings.insert(
+                0,
+                Warning::BaseModesClamped {
+                    requested,
+                    kept: c.modes(),
+                    available,
+                },
+            );
         }
     }
-    run.finish(steps >= max_steps, diverged)
+    Ok((c, r))
+}
+
+impl Deployment {
+    /// The run settings.
+    pub fn settings(&self) -> RunSettings {
+        RunSettings {
+            latching: self.latching,
+            end_time: self.end_time,
+            output_rate: self.output_rate,
+            tolerance: self.tolerance,
+            integrator: self.integrator,
+        }
+    }
+
+    /// The coupled model of this deployment on structure `st` (the structure the scenario
+    /// describes, the deploying plate included): the base without the plate, the chain in
+    /// the root hinge's frame, the panels' 3-D inertias (thin plates), the synchronisation.
+    /// `base_modes = 0` keeps one mode (see [`Warning::BaseModesClamped`]).
+    pub fn coupled(&self, st: &Structure) -> Result<Coupled, DeployError> {
+        let plate = st
+            .plates
+            .iter()
+            .position(|p| p.name == self.plate)
+            .ok_or_else(|| DeployError::UnknownPlate(self.plate.clone()))?;
+        let base = match self.base {
+            BaseKind::Flexible { modes: Some(0) } => BaseKind::Flexible { modes: Some(1) },
+            other => other,
+        };
+        let width = st.plates[plate].width;
+        let chain = Chain {
+            hub: PlanarHub::Fixed,
+            root: [0.0, 0.0],
+            ..self.chain.clone()
+        };
+        let panel_inertia = chain
+            .panels
+            .iter()
+            .map(|p| base::panel_inertia(p.mass, width, p.inertia))
+            .collect();
+        Ok(Coupled {
+            base: BaseModel::new(st, plate, base)?,
+            chain,
+            panel_inertia,
+            sync: self.synchronisation,
+        })
+    }
 }

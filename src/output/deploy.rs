@@ -2,8 +2,10 @@
 
 use super::plot::{line_chart, Series};
 use super::{num, OutputDir, OutputError};
-use crate::deploy::chain::PlanarHub;
-use crate::deploy::{Deployment, DeploymentResult, Latching};
+use crate::deploy::base::BaseKind;
+use crate::deploy::coupled::{Coupled, Synchronisation};
+use crate::deploy::{BodySample, Deployment, DeploymentResult, Latching};
+use crate::structure::HubMotion;
 use serde_json::{json, Value};
 use std::fmt::Write;
 
@@ -14,23 +16,105 @@ fn latching_name(l: Latching) -> &'static str {
     }
 }
 
-fn hub_json(d: &Deployment, r: &DeploymentResult) -> Value {
-    match d.chain.hub {
-        PlanarHub::Fixed => json!({"motion": "fixed"}),
-        PlanarHub::Free { mass, inertia } => json!({
-            "motion": "free",
-            "mass_kg": mass,
-            "inertia_kg_m2": inertia,
-            "position_m": [r.final_q[0], r.final_q[1]],
-            "angle_rad": r.final_q[2],
-            "velocity_m_s": [r.final_qd[0], r.final_qd[1]],
-            "rate_rad_s": r.final_qd[2],
-        }),
+/// The last sample's 3-D state (the state when the run ended).
+fn final_body(r: &DeploymentResult) -> BodySample {
+    r.samples
+        .last()
+        .and_then(|s| s.body.as_deref())
+        .cloned()
+        .unwrap_or_default()
+}
+
+fn hub_json(c: &Coupled, r: &DeploymentResult) -> Value {
+    match c.base.hub_motion {
+        HubMotion::Fixed => json!({"motion": "fixed"}),
+        HubMotion::Free => {
+            let b = final_body(r);
+            json!({
+                "motion": "free",
+                "position_m": b.hub_position,
+                "rotation_vector_rad": b.hub_rotation,
+                "velocity_m_s": b.hub_velocity,
+                "rate_rad_s": b.hub_rate,
+            })
+        }
     }
 }
 
+/// Per base beam, the largest magnitude of its root force (N) and root moment (N·m) over
+/// the deployment's samples, with their times.
+pub fn peak_root_loads(c: &Coupled, r: &DeploymentResult) -> Value {
+    let peak = |b: usize, range: std::ops::Range<usize>| {
+        r.samples
+            .iter()
+            .filter_map(|s| {
+                s.body.as_deref().map(|body| {
+                    let l = &body.root_loads[b];
+                    (
+                        l[range.clone()].iter().map(|x| x * x).sum::<f64>().sqrt(),
+                        s.t,
+                    )
+                })
+            })
+            .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a })
+    };
+    Value::Array(
+        c.base
+            .beams
+            .iter()
+            .enumerate()
+            .map(|(b, beam)| {
+                let (f, tf) = peak(b, 0..3);
+                let (m, tm) = peak(b, 3..6);
+                json!({"beam": beam.name, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
+            })
+            .collect(),
+    )
+}
+
+/// Per hinge, the largest in-plane reaction force (N) and transmitted moment (N·m) over the
+/// deployment's samples, with their times.
+pub fn peak_hinge_reactions(r: &DeploymentResult) -> Value {
+    let n = r.samples.first().map_or(0, |s| s.force.len());
+    Value::Array(
+        (0..n)
+            .map(|i| {
+                let (mut f, mut tf, mut m, mut tm) = (0.0, 0.0, 0.0, 0.0);
+                for s in &r.samples {
+                    let fi = s.force[i][0].hypot(s.force[i][1]);
+                    if fi > f {
+                        (f, tf) = (fi, s.t);
+                    }
+                    if s.moment[i].abs() > m {
+                        (m, tm) = (s.moment[i].abs(), s.t);
+                    }
+                }
+                json!({"hinge": i + 1, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
+            })
+            .collect(),
+    )
+}
+
+/// "flexible, 12 of 40 modes" / "rigid", and the synchronisation's name.
+fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
+    let base = match d.base {
+        BaseKind::Rigid => "rigid".to_string(),
+        BaseKind::Flexible { .. } => format!(
+            "flexible, {} of {} hub-fixed modes",
+            c.modes(),
+            c.base.ritz.dof().saturating_sub(6)
+        ),
+    };
+    let sync = match c.sync {
+        Synchronisation::None => "none".to_string(),
+        Synchronisation::IdealCable => "cable (ideal)".to_string(),
+        Synchronisation::ElasticCable(k) => format!("cable ({k} N·m/rad per loop)"),
+    };
+    (base, sync)
+}
+
 /// The deployment result as one JSON object (`--json` and events.json).
-pub fn deploy_json(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
+pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult) -> String {
     let latches: Vec<Value> = r
         .latches
         .iter()
@@ -48,6 +132,7 @@ pub fn deploy_json(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
                 "hinge_impulses": e.impulses.iter().enumerate().map(|(i, (f, m))| json!({
                     "hinge": i + 1, "force": f, "moment": m,
                 })).collect::<Vec<_>>(),
+                "base_impulse": e.base_impulse.map(|(f, m)| json!({"force": f, "moment": m})),
             })
         })
         .collect();
@@ -56,9 +141,12 @@ pub fn deploy_json(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
             "time": "s", "angles": "rad", "rates": "rad/s", "energy": "J (kinetic)",
             "force": "N·s, linear impulse from the inboard body (hub or panel i−1) on panel i, deployment-plane axes [u along the wing's length axis, v along its normal]",
             "moment": "N·m·s, angular impulse carried by the hinge",
+            "base_impulse": "impulse the base receives at the root hinge, hub axes: force N·s, moment about the hinge point N·m·s",
         },
         "name": name,
         "plate": d.plate,
+        "base": model_names(d, c).0,
+        "synchronisation": model_names(d, c).1,
         "panels": d.chain.len(),
         "latching": latching_name(d.latching),
         "latches": latches,
@@ -67,22 +155,26 @@ pub fn deploy_json(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
         "unlatched": r.unlatched.iter().map(|(h, a)| json!({"hinge": h, "angle": a})).collect::<Vec<_>>(),
         "swing_back": r.swing_back.iter().map(|s| json!({"hinge": s.hinge, "first_time": s.first_time, "min_angle": s.min_angle})).collect::<Vec<_>>(),
         "warnings": r.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
-        "hub": hub_json(d, r),
+        "hub": hub_json(c, r),
+        "peak_root_loads": peak_root_loads(c, r),
+        "peak_hinge_reactions": peak_hinge_reactions(r),
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }
 
 /// The terminal event table.
-pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String {
+pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult) -> String {
     let mut s = String::new();
-    let hub = match d.chain.hub {
-        PlanarHub::Fixed => "fixed",
-        PlanarHub::Free { .. } => "free",
+    let hub = match c.base.hub_motion {
+        HubMotion::Fixed => "fixed",
+        HubMotion::Free => "free",
     };
+    let (base, sync) = model_names(d, c);
     let _ = writeln!(s, "flexcraft deploy: {name}");
     let _ = writeln!(
         s,
-        "plate {}, {} panels, hub {hub}, latching {} (SI units: s, rad, rad/s, J, N·s, N·m·s)",
+        "plate {}, {} panels, hub {hub}, base {base}, synchronisation {sync}, latching {} \
+         (SI units: s, rad, rad/s, J, N·s, N·m·s)",
         d.plate,
         d.chain.len(),
         latching_name(d.latching)
@@ -127,6 +219,13 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
         if show < d.chain.len() {
             let _ = writeln!(s, "   … {} more hinges in --json", d.chain.len() - show);
         }
+        if let Some((f, m)) = e.base_impulse {
+            let _ = writeln!(
+                s,
+                "impulse on the base at the root hinge (hub axes): force [{:.6e}, {:.6e}, {:.6e}] N·s, moment [{:.6e}, {:.6e}, {:.6e}] N·m·s",
+                f[0], f[1], f[2], m[0], m[1], m[2]
+            );
+        }
     }
     let _ = writeln!(
         s,
@@ -138,11 +237,13 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
         },
         r.final_time
     );
-    if let PlanarHub::Free { .. } = d.chain.hub {
+    if c.base.hub_motion == HubMotion::Free {
+        let b = final_body(r);
+        let (p, a, v, w) = (b.hub_position, b.hub_rotation, b.hub_velocity, b.hub_rate);
         let _ = writeln!(
             s,
-            "hub (centre of mass, deployment plane u, v; rotation θ): position [{:.6e}, {:.6e}] m, θ = {:.6e} rad; velocity [{:.6e}, {:.6e}] m/s, θ̇ = {:.6e} rad/s",
-            r.final_q[0], r.final_q[1], r.final_q[2], r.final_qd[0], r.final_qd[1], r.final_qd[2]
+            "hub (centre of mass, inertial axes): position [{:.6e}, {:.6e}, {:.6e}] m, rotation vector [{:.6e}, {:.6e}, {:.6e}] rad; velocity [{:.6e}, {:.6e}, {:.6e}] m/s, rate [{:.6e}, {:.6e}, {:.6e}] rad/s",
+            p[0], p[1], p[2], a[0], a[1], a[2], v[0], v[1], v[2], w[0], w[1], w[2]
         );
     }
     for w in &r.warnings {
@@ -151,54 +252,112 @@ pub fn deploy_table(name: &str, d: &Deployment, r: &DeploymentResult) -> String 
     s
 }
 
+/// The header of deployment.csv (units in brackets).
+fn csv_header(c: &Coupled) -> String {
+    let n = c.panels();
+    let mut h = String::from("t [s]");
+    let mut cols = |name: String| {
+        h.push(',');
+        h.push_str(&name);
+    };
+    (1..=n).for_each(|i| cols(format!("alpha_{i} [rad]")));
+    (1..=n).for_each(|i| cols(format!("rate_{i} [rad/s]")));
+    for (q, unit) in [
+        ("hub_", "m"),
+        ("hub_r", "rad"),
+        ("hub_v", "m/s"),
+        ("hub_w", "rad/s"),
+    ] {
+        for a in ["x", "y", "z"] {
+            cols(format!("{q}{a} [{unit}]"));
+        }
+    }
+    (1..=c.modes()).for_each(|j| cols(format!("base_eta_{j} [kg^0.5·m]")));
+    for b in &c.base.beams {
+        for a in ["u", "v", "w"] {
+            cols(format!("{}_tip_{a} [m]", b.name));
+        }
+        cols(format!("{}_tip_twist [rad]", b.name));
+    }
+    for b in &c.base.beams {
+        for a in ["fx", "fy", "fz"] {
+            cols(format!("{}_root_{a} [N]", b.name));
+        }
+        for a in ["mx", "my", "mz"] {
+            cols(format!("{}_root_{a} [N·m]", b.name));
+        }
+    }
+    (1..=n).for_each(|i| cols(format!("reaction_u_{i} [N]")));
+    (1..=n).for_each(|i| cols(format!("reaction_v_{i} [N]")));
+    (1..=n).for_each(|i| cols(format!("moment_{i} [N·m]")));
+    if c.sync != Synchronisation::None {
+        (1..n).for_each(|k| cols(format!("cable_torque_{k} [N·m]")));
+    }
+    for e in ["kinetic_energy", "spring_energy", "elastic_energy"] {
+        cols(format!("{e} [J]"));
+    }
+    for a in ["x", "y", "z"] {
+        cols(format!("p_{a} [N·s]"));
+    }
+    for a in ["x", "y", "z"] {
+        cols(format!("l_{a} [N·m·s]"));
+    }
+    h.push('\n');
+    h
+}
+
+/// deployment.csv: one row per sample, the columns of [`csv_header`].
+fn deployment_csv(c: &Coupled, r: &DeploymentResult) -> String {
+    let mut out = csv_header(c);
+    let blank = BodySample {
+        eta: vec![0.0; c.modes()],
+        beam_tips: vec![[0.0; 4]; c.base.beams.len()],
+        root_loads: vec![[0.0; 6]; c.base.beams.len()],
+        ..BodySample::default()
+    };
+    let cables = if c.sync == Synchronisation::None {
+        0
+    } else {
+        c.panels().saturating_sub(1)
+    };
+    for s in &r.samples {
+        let b = s.body.as_deref().unwrap_or(&blank);
+        let mut row: Vec<f64> = Vec::new();
+        row.extend(&s.alpha);
+        row.extend(&s.rate);
+        for v in [b.hub_position, b.hub_rotation, b.hub_velocity, b.hub_rate] {
+            row.extend(v);
+        }
+        row.extend(&b.eta);
+        b.beam_tips.iter().for_each(|t| row.extend(t));
+        b.root_loads.iter().for_each(|l| row.extend(l));
+        row.extend(s.force.iter().map(|f| f[0]));
+        row.extend(s.force.iter().map(|f| f[1]));
+        row.extend(&s.moment);
+        row.extend((0..cables).map(|k| b.cable_torque.get(k).copied().unwrap_or(0.0)));
+        row.extend([s.kinetic, s.spring, b.elastic]);
+        row.extend(b.momentum);
+        row.extend(b.angular_momentum);
+        out.push_str(&num(s.t));
+        for v in row {
+            out.push(',');
+            out.push_str(&num(v));
+        }
+        out.push('\n');
+    }
+    out
+}
+
 /// Writes deployment.csv, events.json and plots/*.{png,svg}.
 pub fn write_deploy(
     dir: &mut OutputDir,
     name: &str,
     d: &Deployment,
+    c: &Coupled,
     r: &DeploymentResult,
 ) -> Result<(), OutputError> {
-    let n = d.chain.len();
-    dir.write("events.json", deploy_json(name, d, r) + "\n")?;
-    let mut c = String::from("t [s]");
-    for i in 1..=n {
-        let _ = write!(c, ",alpha_{i} [rad]");
-    }
-    for i in 1..=n {
-        let _ = write!(c, ",rate_{i} [rad/s]");
-    }
-    c.push_str(",hub_u [m],hub_v [m],hub_theta [rad]");
-    for i in 1..=n {
-        let _ = write!(c, ",reaction_u_{i} [N]");
-    }
-    for i in 1..=n {
-        let _ = write!(c, ",reaction_v_{i} [N]");
-    }
-    for i in 1..=n {
-        let _ = write!(c, ",moment_{i} [N·m]");
-    }
-    c.push_str(",kinetic_energy [J],spring_energy [J]\n");
-    for s in &r.samples {
-        c.push_str(&num(s.t));
-        for v in s.alpha.iter().chain(&s.rate).chain(&s.hub) {
-            c.push(',');
-            c.push_str(&num(*v));
-        }
-        for f in &s.force {
-            c.push(',');
-            c.push_str(&num(f[0]));
-        }
-        for f in &s.force {
-            c.push(',');
-            c.push_str(&num(f[1]));
-        }
-        for m in &s.moment {
-            c.push(',');
-            c.push_str(&num(*m));
-        }
-        let _ = writeln!(c, ",{},{}", num(s.kinetic), num(s.spring));
-    }
-    dir.write("deployment.csv", c)?;
+    dir.write("events.json", deploy_json(name, d, c, r) + "\n")?;
+    dir.write("deployment.csv", deployment_csv(c, r))?;
 
     for f in super::figures::deployment_figures(d, r) {
         f.draw(dir)?;

@@ -48,7 +48,9 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             "momentum_before": {"linear": v3(h.momentum_before.linear), "angular": v3(h.momentum_before.angular)},
             "momentum_after": {"linear": v3(h.momentum_after.linear), "angular": v3(h.momentum_after.angular)},
             "angle_mismatch": h.angle_mismatch,
-            "hub_in_deployment_plane": h.hub_state,
+            "elastic_energy_before": h.elastic_energy_before,
+            "elastic_energy_after": h.elastic_energy_after,
+            "projection_residual": (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
         },
         "response": {
             "duration": st.duration,
@@ -97,7 +99,10 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
                 "energy_after": e.energy_after,
                 "hinge_impulses": e.impulses.iter().enumerate().map(|(i, (f, m))| json!({
                     "hinge": i + 1, "force": f, "moment": m})).collect::<Vec<_>>(),
+                "base_impulse": e.base_impulse.map(|(f, m)| json!({"force": f, "moment": m})),
             })).collect::<Vec<_>>(),
+            "peak_root_loads": super::deploy::peak_root_loads(&sim.coupled, dep),
+            "peak_hinge_reactions": super::deploy::peak_hinge_reactions(dep),
         },
         "modes": {
             "dof": sim.modes.dof,
@@ -134,7 +139,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
     );
     if let Some(d) = &s.deployment {
         o.push('\n');
-        o.push_str(&deploy_table(&s.name, d, &sim.deployment));
+        o.push_str(&deploy_table(&s.name, d, &sim.coupled, &sim.deployment));
     }
     let Some(r) = &sim.response else {
         let _ = writeln!(o, "\nno response: the array did not latch completely");
@@ -196,6 +201,20 @@ fn handover_lines(o: &mut String, r: &Response) {
         h.energy_after,
         lost,
         100.0 * lost / h.energy_before.max(1e-300)
+    );
+    let (before, after) = (
+        h.energy_before + h.elastic_energy_before,
+        h.energy_after + h.elastic_energy_after,
+    );
+    let _ = writeln!(
+        o,
+        "  elastic energy before {:.6e} J, after {:.6e} J; total {:.6e} J → {:.6e} J: projection residual {:.6e} J ({:.4} %)",
+        h.elastic_energy_before,
+        h.elastic_energy_after,
+        before,
+        after,
+        before - after,
+        100.0 * (before - after) / before.max(1e-300)
     );
     let _ = writeln!(
         o,
@@ -303,7 +322,7 @@ pub fn write_simulate(
     )?;
     dir.write("modes.json", modes_json(&sim.model, &sim.modes) + "\n")?;
     if let Some(d) = &s.deployment {
-        write_deploy(dir, &s.name, d, &sim.deployment)?;
+        write_deploy(dir, &s.name, d, &sim.coupled, &sim.deployment)?;
     }
     let Some(r) = &sim.response else {
         return Ok(());
@@ -312,7 +331,8 @@ pub fn write_simulate(
     let hist = &r.history;
     let file = std::fs::File::create(dir.path("response.csv")?)?;
     let mut w = csv_writer(std::io::BufWriter::with_capacity(1 << 16, file));
-    let mut header = vec!["t [s]".to_string()];
+    // t from release (one timeline with deployment.csv) and from the final latch.
+    let mut header = vec!["t [s]".to_string(), "t_after_latch [s]".to_string()];
     header.extend(
         r.channels
             .iter()
@@ -326,7 +346,9 @@ pub fn write_simulate(
     );
     let csv_err = |e: csv::Error| OutputError::Io(std::io::Error::other(e));
     w.write_record(&header).map_err(csv_err)?;
+    let t_latch = r.handover.latch_time;
     for (k, &t) in hist.times.iter().enumerate() {
+        w.write_field(num(t_latch + t)).map_err(csv_err)?;
         w.write_field(num(t)).map_err(csv_err)?;
         for j in 0..r.channels.len() {
             w.write_field(num(hist.values[(k, j)])).map_err(csv_err)?;

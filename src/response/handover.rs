@@ -32,6 +32,7 @@
 use super::ResponseError;
 use crate::basis::{Basis1d, Quadrature};
 use crate::deploy::chain::{Chain, PlanarHub, P2};
+use crate::deploy::coupled::Coupled;
 use crate::deploy::{Deployment, DeploymentResult, LatchEvent};
 use crate::math::Vec3;
 use crate::ritz::assembly::{Element, ElementKind, FieldKind, HUB_DOF};
@@ -98,8 +99,17 @@ pub struct Handover {
     /// Largest |α_i − latch angle_i| at the final latch, rad (non-zero only with
     /// simultaneous latching: the hand-over still uses the straight wing).
     pub angle_mismatch: f64,
-    /// Hub position u, v (m) and rotation θ (rad) in the deployment plane at the latch.
+    /// Hub position u, v (m) and rotation θ (rad) in the deployment plane at the latch
+    /// (planar chain; zero for the coupled model, whose hub pose is in the deployment's
+    /// samples).
     pub hub_state: [f64; 3],
+    /// Initial modal displacements η_j(0) = φ_jᵀ M q(0), one per mode (the base's elastic
+    /// displacement at the final latch; zero for the planar chain).
+    pub modal_displacement: Vec<f64>,
+    /// Elastic energy of the base just after the final latch (coupled model), J.
+    pub elastic_energy_before: f64,
+    /// Elastic energy of the initial displacement in the deployed model, ½Σ ω_j² η_j(0)², J.
+    pub elastic_energy_after: f64,
     /// Notes on choices the data forced (printed as warnings).
     pub notes: Vec<String>,
 }
@@ -158,6 +168,9 @@ struct PreLatch {
     /// Hub's centre-of-mass velocity and angular velocity.
     v_hub: Vec3,
     w_hub: Vec3,
+    /// The base's elastic velocity in the deployed model's coordinates (hub's six zero;
+    /// empty for the planar chain's rigid base).
+    base_velocity: Vec<f64>,
     /// Per panel: place on the straight wing, mass properties and rigid motion (structure
     /// frame).
     panels: Vec<PanelMotion>,
@@ -235,6 +248,7 @@ fn pre_latch(chain: &Chain, plate: &Plate, ev: &LatchEvent) -> PreLatch {
     PreLatch {
         v_hub,
         w_hub,
+        base_velocity: Vec::new(),
         panels,
         theta,
         hub_state,
@@ -400,6 +414,186 @@ pub fn hand_over(
         momentum_after,
         angle_mismatch,
         hub_state: pl.hub_state,
+        modal_displacement: vec![0.0; modal.modes.len()],
+        elastic_energy_before: 0.0,
+        elastic_energy_after: 0.0,
+        notes,
+    })
+}
+
+/// For every coordinate of the base's Ritz model, its index in the deployed model's (the
+/// same components with the same functions, the deploying plate added; matched by name).
+fn base_coordinates(base: &RitzModel, model: &RitzModel) -> Vec<usize> {
+    let mut map = vec![0; base.dof()];
+    for (i, m) in map.iter_mut().enumerate().take(HUB_DOF) {
+        *m = i;
+    }
+    for e in &base.elements {
+        let name = base.structure.component_name(e.id);
+        let Some(f) = model
+            .elements
+            .iter()
+            .find(|f| model.structure.component_name(f.id) == name)
+        else {
+            continue;
+        };
+        for (a, b) in e.own_range().zip(f.own_range()) {
+            map[a] = b;
+        }
+    }
+    map
+}
+
+/// The base's elastic velocity and displacement in the deployed model's coordinates.
+fn base_state(coupled: &Coupled, model: &RitzModel, y: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let n = model.dof();
+    let sv = coupled.view(y);
+    let map = base_coordinates(&coupled.base.ritz, model);
+    let (mut velocity, mut q0) = (vec![0.0; n], vec![0.0; n]);
+    for (k, shape) in coupled.base.shapes.iter().enumerate() {
+        for (i, v) in shape.iter().enumerate() {
+            velocity[map[i]] += v * sv.eta_dot[k];
+            q0[map[i]] += v * sv.eta[k];
+        }
+    }
+    (velocity, q0)
+}
+
+/// Hands the coupled model's state after the final latch ([`crate::deploy::coupled`]) over
+/// to the deployed structure's Ritz model: the base's rigid and elastic velocity and its
+/// elastic displacement map one to one onto the deployed model's coordinates (the base's
+/// functions are a subset of the deployed model's); the locked panels' rigid motion is
+/// projected onto the plate's functions in the mass metric, as at the planar chain's latch
+/// (module documentation). The kinetic energy can only drop by the projection residual
+/// ½∫ρ|v − Φq̇⁺|² dV over the wing, which shrinks as the plate's terms grow (the locked rigid
+/// wing is the stiff limit of the elastic plate); the elastic energy of the base carries over
+/// unchanged.
+pub fn hand_over_coupled(
+    model: &RitzModel,
+    modal: &ModalAnalysis,
+    deployment: &Deployment,
+    coupled: &Coupled,
+    result: &DeploymentResult,
+    method: HandoverMethod,
+) -> Result<Handover, ResponseError> {
+    let last = match result.latches.last() {
+        Some(ev) if result.all_latched => ev,
+        _ => {
+            return Err(ResponseError::NotLatched {
+                hinges: result.unlatched.iter().map(|u| u.0).collect(),
+                time: result.final_time,
+            })
+        }
+    };
+    let view = PlateView::find(model, &deployment.plate)?;
+    let n = model.dof();
+    let y: Vec<f64> = result
+        .final_q
+        .iter()
+        .chain(&result.final_qd)
+        .copied()
+        .collect();
+    let sv = coupled.view(&y);
+    let (base_velocity, q0) = base_state(coupled, model, &y);
+    let ev = coupled.evaluate(&y);
+    let ea = view.plate.length_axis;
+    let mut start = 0.0;
+    let panels = coupled
+        .panel_motion(&y, &ev)
+        .into_iter()
+        .zip(&coupled.chain.panels)
+        .map(|((_, v, w), p)| {
+            let pm = PanelMotion {
+                start,
+                length: p.length,
+                mass: p.mass,
+                inertia: p.inertia,
+                v_centre: v,
+                v_per_metre: w.cross(ea),
+                omega: w,
+            };
+            start += p.length;
+            pm
+        })
+        .collect();
+    let pl = PreLatch {
+        v_hub: sv.v,
+        w_hub: sv.w,
+        base_velocity,
+        panels,
+        theta: 0.0,
+        hub_state: [0.0; 3],
+    };
+    let mut notes = Vec::new();
+    let energy_before = coupled.kinetic_energy(&y);
+    let (b, energy_before_field) = match method {
+        HandoverMethod::Projection => projected_impulse(model, &view, &pl, &mut notes),
+        HandoverMethod::Impulse => (latch_impulse(model, &view, &pl, last), energy_before),
+    };
+    let (linear, angular) = coupled.momentum_hub(&y);
+    // Rows 0..6 of b = M q̇⁺ are the linear model's momentum. The projection gives the
+    // momentum of the velocity field in the undeformed geometry; the coupled model's is that
+    // of the deformed base (they differ by terms like (S η) × v, second order in the small
+    // deformation). Setting those rows to the coupled model's momentum makes the response
+    // carry it exactly; the kinetic energy changes by a second-order amount.
+    let mut b = b;
+    if method == HandoverMethod::Projection && model.structure.hub.motion == HubMotion::Free {
+        for i in 0..3 {
+            b[i] = linear.get(i);
+            b[3 + i] = angular.get(i);
+        }
+    }
+    let (eta_dot, qdot, energy_after, momentum_after) = after_latch(model, modal, &b);
+    // η(0) = Φᵀ M q(0).
+    let m = &model.mass;
+    let mq0: Vec<f64> = (0..n)
+        .map(|r| (0..n).map(|c| m[(r, c)] * q0[c]).sum())
+        .collect();
+    let modal_displacement: Vec<f64> = match method {
+        HandoverMethod::Projection => modal_velocities(modal, &mq0),
+        HandoverMethod::Impulse => vec![0.0; modal.modes.len()],
+    };
+    let elastic_energy_after = modal
+        .modes
+        .iter()
+        .zip(&modal_displacement)
+        .map(|(md, e)| 0.5 * md.omega_rad_s.powi(2) * e * e)
+        .sum();
+    let off = coupled.alpha_offset();
+    let angle_mismatch = coupled
+        .chain
+        .hinges
+        .iter()
+        .enumerate()
+        .map(|(i, h)| (result.final_q[off + i] - h.latch_angle).abs())
+        .fold(0.0, f64::max);
+    if (energy_before_field - energy_before).abs() > 1e-6 * energy_before.abs().max(1e-300)
+        && method == HandoverMethod::Projection
+    {
+        notes.push(format!(
+            "the panels' masses or inertias differ from the plate's density field: kinetic \
+             energy after the final latch {energy_before:.6e} J in the coupled model, \
+             {energy_before_field:.6e} J from the plate's field (the hand-over projects the \
+             plate's)"
+        ));
+    }
+    Ok(Handover {
+        method,
+        latch_time: last.time,
+        latch_hinge: last.hinge,
+        generalized_impulse: b,
+        modal_velocity: eta_dot,
+        qdot,
+        energy_before,
+        energy_before_field,
+        energy_after,
+        momentum_before: Momentum { linear, angular },
+        momentum_after,
+        angle_mismatch,
+        hub_state: [0.0; 3],
+        modal_displacement,
+        elastic_energy_before: coupled.elastic_energy(&y),
+        elastic_energy_after,
         notes,
     })
 }
@@ -437,8 +631,6 @@ fn projected_impulse(
 ) -> (Vec<f64>, f64) {
     let st = &model.structure;
     let n = model.dof();
-    let c_hub = st.hub.center_of_mass;
-    let origin = view.element.origin;
     let (ea, nn) = (view.plate.length_axis, view.plate.normal);
     let (a, width, mu) = (
         view.plate.length,
@@ -451,6 +643,9 @@ fn projected_impulse(
     let mut yv = vec![[0.0; 4]; ny];
     // q̇_h: the hub's rigid velocity in Ritz coordinates.
     let mut qh = vec![0.0; n];
+    for (q, v) in qh.iter_mut().zip(&pl.base_velocity) {
+        *q += v;
+    }
     if st.hub.motion == HubMotion::Free {
         for i in 0..3 {
             qh[i] = pl.v_hub.get(i);
@@ -476,7 +671,14 @@ fn projected_impulse(
     let (mut fu, mut fth) = (Vec3::ZERO, Vec3::ZERO);
     let mut fg = vec![0.0; nx * ny];
     let mut ke_delta = 0.0;
-    let rigid = |x: f64| pl.v_hub + pl.w_hub.cross(origin + ea * x - c_hub);
+    // The plate's velocity when it moves with its attachment section: [U̇; Θ̇] = T q̇_h.
+    let t = &view.element.attachment;
+    let row = |r: usize| (0..n).map(|c| t[(r, c)] * qh[c]).sum::<f64>();
+    let (u_dot, th_dot) = (
+        Vec3::new(row(0), row(1), row(2)),
+        Vec3::new(row(3), row(4), row(5)),
+    );
+    let rigid = |x: f64| u_dot + th_dot.cross(ea * x);
     for p in &pl.panels {
         for (&xi, &w) in xq.points.iter().zip(&xq.weights) {
             let s = xi * p.length;
@@ -499,8 +701,13 @@ fn projected_impulse(
     let m = &model.mass;
     let mut kinetic_h = 0.0;
     let mut cross = 0.0;
+    let nq = if pl.base_velocity.is_empty() {
+        HUB_DOF
+    } else {
+        n
+    };
     for r in 0..n {
-        let mq: f64 = (0..HUB_DOF).map(|c| m[(r, c)] * qh[c]).sum();
+        let mq: f64 = (0..nq).map(|c| m[(r, c)] * qh[c]).sum();
         kinetic_h += 0.5 * qh[r] * mq;
         cross += qh[r] * b[r];
         b[r] += mq;

@@ -62,24 +62,42 @@ impl ModalResponse {
     /// Keeps every rigid mode and the first `settings.modes` elastic ones (all when `None`,
     /// clamped to the model's number), starting from η₀ = 0 and η̇₀ = `modal_velocity`.
     pub fn new(modal: &ModalAnalysis, modal_velocity: &[f64], settings: &ResponseSettings) -> Self {
+        let zero = vec![0.0; modal_velocity.len()];
+        Self::with_initial(modal, &zero, modal_velocity, settings)
+    }
+
+    /// As [`ModalResponse::new`], starting from η₀ = `modal_displacement`; the captured energy
+    /// counts kinetic and elastic energy, ½(η̇² + ω²η²) per mode.
+    pub fn with_initial(
+        modal: &ModalAnalysis,
+        modal_displacement: &[f64],
+        modal_velocity: &[f64],
+        settings: &ResponseSettings,
+    ) -> Self {
         let available = modal.modes.iter().filter(|m| !m.rigid).count();
         let keep = settings.modes.unwrap_or(available).min(available);
         let mut elastic_seen = 0;
         let mut modes = Vec::new();
         let (mut kept_e, mut total_e) = (0.0, 0.0);
-        for (m, &v) in modal.modes.iter().zip(modal_velocity) {
-            total_e += 0.5 * v * v;
+        for ((m, &v), &e) in modal
+            .modes
+            .iter()
+            .zip(modal_velocity)
+            .zip(modal_displacement)
+        {
+            let energy = 0.5 * (v * v + (m.omega_rad_s * e).powi(2));
+            total_e += energy;
             let take = m.rigid || {
                 elastic_seen += 1;
                 elastic_seen <= keep
             };
             if take {
-                kept_e += 0.5 * v * v;
+                kept_e += energy;
                 modes.push(KeptMode {
                     number: m.number,
                     rigid: m.rigid,
                     omega_rad_s: m.omega_rad_s,
-                    eta0: 0.0,
+                    eta0: e,
                     eta_dot0: v,
                 });
             }

@@ -3,11 +3,14 @@
 //! from the structure by [`crate::deploy::planar`].
 
 use super::context::Ctx;
-use super::raw::{RawDeployment, RawLatching, RawMotion, S};
+use super::raw::{RawBase, RawDeployment, RawIntegrator, RawLatching, RawSynchronisation, S};
 use super::ScenarioError;
+use crate::deploy::base::BaseKind;
 use crate::deploy::chain::Hinge;
-use crate::deploy::{Deployment, Latching};
+use crate::deploy::coupled::Synchronisation;
+use crate::deploy::{Deployment, Integrator, Latching};
 use crate::limits as L;
+use crate::structure::HubMotion;
 use crate::structure::Structure;
 
 /// Default deployment settings (docs/scenario.md).
@@ -26,6 +29,14 @@ pub(super) fn lower(
     st: &Structure,
 ) -> Result<Deployment, ScenarioError> {
     let d = raw.get_ref();
+    if let Some(h) = &d.hub {
+        return Err(cx.invalid(
+            h.span(),
+            "deployment.hub",
+            "this key is gone: the hub moves the same way during deployment and response, \
+             as [hub] motion says (\"free\" or \"fixed\"); remove deployment.hub",
+        ));
+    }
     let plate_index = st
         .plates
         .iter()
@@ -66,7 +77,7 @@ pub(super) fn lower(
             inertia: panel_inertia,
         },
         hinges,
-        matches!(d.hub.as_ref().map(|h| *h.get_ref()), Some(RawMotion::Free)),
+        st.hub.motion == HubMotion::Free,
     );
     // Panel masses and inertias derived from the plate obey the ranges of given ones.
     if let Some(p) = chain
@@ -88,7 +99,14 @@ pub(super) fn lower(
         ));
     }
     let (end_time, output_rate, tolerance) = run_settings(cx, raw)?;
+    let synchronisation = synchronisation(cx, raw, &chain.hinges)?;
     Ok(Deployment {
+        integrator: match d.integrator.as_ref().map(|i| *i.get_ref()) {
+            Some(RawIntegrator::Implicit) => Integrator::Implicit,
+            _ => Integrator::Explicit,
+        },
+        base: base(cx, raw)?,
+        synchronisation,
         plate: plate.name.clone(),
         chain,
         latching: match d.latching.as_ref().map(|l| *l.get_ref()) {
@@ -99,6 +117,111 @@ pub(super) fn lower(
         output_rate,
         tolerance,
     })
+}
+
+/// `base` and `base_modes`.
+fn base(cx: &Ctx, raw: &S<RawDeployment>) -> Result<BaseKind, ScenarioError> {
+    let d = raw.get_ref();
+    let rigid = matches!(d.base.as_ref().map(|b| *b.get_ref()), Some(RawBase::Rigid));
+    match &d.base_modes {
+        None if rigid => Ok(BaseKind::Rigid),
+        None => Ok(BaseKind::Flexible { modes: None }),
+        Some(m) if rigid => Err(cx.invalid(
+            m.span(),
+            "deployment.base_modes",
+            "a rigid base (base = \"rigid\") has no modes to keep: remove base_modes or set \
+             base = \"flexible\"",
+        )),
+        Some(m) => {
+            let k = *m.get_ref();
+            if k < 0 {
+                return Err(cx.invalid(
+                    m.span(),
+                    "deployment.base_modes",
+                    format!("must be a number of modes (0 or more), got {k}"),
+                ));
+            }
+            Ok(BaseKind::Flexible {
+                modes: Some(usize::try_from(k).unwrap_or(usize::MAX)),
+            })
+        }
+    }
+}
+
+/// Relative tolerance of the cable law's check on the hinges' angles and rates.
+const CABLE_LAW_TOL: f64 = 1e-9;
+
+/// `synchronisation` and `cable_stiffness`. The cable law ties the hinges' openings,
+/// α_2 − α_2(0) = 2 (α_1 − α_1(0)) and α_{i+1} − α_{i+1}(0) = α_i − α_i(0), whatever the
+/// panel lengths; it is refused when the latch angles (or the initial rates) do not follow
+/// it, since then the hinges could not all reach their latch angles together.
+fn synchronisation(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+    hinges: &[Hinge],
+) -> Result<Synchronisation, ScenarioError> {
+    let d = raw.get_ref();
+    let cable = matches!(
+        d.synchronisation.as_ref().map(|s| *s.get_ref()),
+        Some(RawSynchronisation::Cable)
+    );
+    let stiffness = match &d.cable_stiffness {
+        Some(k) if !cable => {
+            return Err(cx.invalid(
+                k.span(),
+                "deployment.cable_stiffness",
+                "only a cable has a stiffness: set synchronisation = \"cable\" or remove \
+                 cable_stiffness",
+            ))
+        }
+        Some(k) => Some(cx.bounded(k, "deployment.cable_stiffness", L::CABLE_STIFFNESS)?),
+        None => None,
+    };
+    if !cable {
+        return Ok(Synchronisation::None);
+    }
+    let span = d.synchronisation.as_ref().map_or(raw.span(), |s| s.span());
+    if hinges.len() < 2 {
+        return Err(cx.invalid(
+            span,
+            "deployment.synchronisation",
+            "a cable ties neighbouring hinges: it needs at least 2 panels",
+        ));
+    }
+    let opening = |h: &Hinge| h.latch_angle - h.initial_angle;
+    let root = opening(&hinges[0]);
+    for (i, h) in hinges.iter().enumerate().skip(1) {
+        let want = 2.0 * root;
+        if (opening(h) - want).abs() > CABLE_LAW_TOL * want.abs().max(1.0) {
+            return Err(cx.invalid(
+                span,
+                "deployment.synchronisation",
+                format!(
+                    "the cable opens every interior hinge twice as far as the root hinge \
+                     (α_i − α_i(0) = 2 (α_1 − α_1(0))), so all reach their latch angles \
+                     together only if latch_angle − initial_angle is {want} rad for hinge {} \
+                     (root hinge: {root} rad); it is {} rad. Adjust latch_angle / \
+                     initial_angle or remove synchronisation",
+                    i + 1,
+                    opening(h)
+                ),
+            ));
+        }
+        let rate = 2.0 * hinges[0].initial_rate;
+        if (h.initial_rate - rate).abs() > CABLE_LAW_TOL * rate.abs().max(1.0) {
+            return Err(cx.invalid(
+                span,
+                "deployment.synchronisation",
+                format!(
+                    "the cable makes every interior hinge's rate twice the root hinge's: \
+                     hinge {} needs initial_rate {rate} rad/s, it has {} rad/s",
+                    i + 1,
+                    h.initial_rate
+                ),
+            ));
+        }
+    }
+    Ok(stiffness.map_or(Synchronisation::IdealCable, Synchronisation::ElasticCable))
 }
 
 /// `panels` (equal lengths) or `panel_lengths` (summing to the plate's length).

@@ -171,8 +171,14 @@ pub struct RawDeployment {
     pub plate: S<String>,
     pub panels: Option<S<i64>>,
     pub panel_lengths: Option<S<Vec<f64>>>,
-    pub hub: Option<S<RawMotion>>,
+    /// Gone: the hub's motion is `[hub] motion` (refused with that message).
+    pub hub: Option<S<toml::Value>>,
     pub latching: Option<S<RawLatching>>,
+    pub base: Option<S<RawBase>>,
+    pub base_modes: Option<S<i64>>,
+    pub synchronisation: Option<S<RawSynchronisation>>,
+    pub cable_stiffness: Option<S<f64>>,
+    pub integrator: Option<S<RawIntegrator>>,
     pub end_time: Option<S<f64>>,
     pub output_rate: Option<S<f64>>,
     pub tolerance: Option<S<f64>>,
@@ -180,6 +186,27 @@ pub struct RawDeployment {
     pub panel_inertia: Option<S<f64>>,
     pub hinge: Option<S<RawHingeAll>>,
     pub hinges: Option<Vec<S<RawHinge>>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawBase {
+    Flexible,
+    Rigid,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawIntegrator {
+    Implicit,
+    Explicit,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawSynchronisation {
+    None,
+    Cable,
 }
 
 #[derive(Debug, Deserialize)]

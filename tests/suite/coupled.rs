@@ -181,7 +181,6 @@ terms = { length = 4, width = 2 }
 [deployment]
 plate = "wing"
 panels = 3
-hub = "free"
 end_time = 6.0
 output_rate = 10.0
 tolerance = 1e-12

@@ -1048,6 +1048,9 @@ fn rigid_mast_limit_agrees_with_the_rigid_chain() {
         latching: Latching::Sequential,
         end_time: case.end_time,
         output_rate: 10.0,
+        base: flexcraft::deploy::base::BaseKind::Rigid,
+        synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
+        integrator: flexcraft::deploy::Integrator::Explicit,
         tolerance: 1e-12,
     });
     assert_eq!(

@@ -48,6 +48,9 @@ pub fn deployment(chain: Chain, latching: Latching, tol: f64) -> Deployment {
         latching,
         end_time: 400.0,
         output_rate: 10.0,
+        base: flexcraft::deploy::base::BaseKind::Rigid,
+        synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
+        integrator: flexcraft::deploy::Integrator::Explicit,
         tolerance: tol,
     }
 }

@@ -1,0 +1,267 @@
+//! Loads and impulses of the coupled model ([`super::coupled`]): the hinge reactions, every
+//! base beam's root loads and tip deflection, the impulses of a latch, and the coupled
+//! model as an [`Engine`] of a deployment run.
+//!
+//! Hinge reactions (Newton–Euler on the outboard sub-chain, hinge components): with the
+//! panels' inertial accelerations a_i, angular velocities ω_i and accelerations ε_i,
+//!   F_l = Σ_{i≥l} m_i a_i,   M_l = Σ_{i≥l} (c_i − h_l) × m_i a_i + I_i ε_i + ω_i × I_i ω_i,
+//! the force the inboard body applies to panel l and the moment its hinge transmits (the
+//! planar chain's F_i and M_i when the root hinge is held).
+//!
+//! Root loads of a base beam: the beam and everything outboard of it (its subtree, and the
+//! array when it hangs there) is a free body on which only its parent acts, so the parent's
+//! force and moment about the hub's centre of mass O are the rates of its momenta
+//! ([`super::inertia::Invariants::wrench`]) plus, for a subtree that carries the array, the
+//! wrench it applies to panel 1 at the root hinge H:
+//!   F = ṗ_s + ω × p_s + W_F,   M_O = ḣ_s + ω × h_s + v × p_s + M_H + r_H × W_F,
+//! moved to the root point r_b: M_b = M_O − r_b × F. Momentum rates give the loads without
+//! differentiating the truncated elastic field twice, as a stress recovery from curvatures
+//! would.
+
+use super::attitude;
+use super::chain::{Hinge, P2};
+use super::coupled::{Coupled, Eval, Solution, Synchronisation};
+use super::inertia::combine;
+use super::run::{Engine, Impulses};
+use super::{BodySample, Sample};
+use crate::math::Vec3;
+
+/// ẑ, the hinge axis in hinge components.
+const Z: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+
+impl Coupled {
+    /// The panels' inertial accelerations, angular velocities and angular accelerations
+    /// (hinge components) for the solution `sol` at state `y`.
+    fn panel_accelerations(&self, y: &[f64], ev: &Eval, sol: &Solution) -> Vec<[Vec3; 3]> {
+        let s = self.view(y);
+        let u = &y[self.positions()..];
+        let nb = self.rate_offset();
+        let omega = Vec3::new(
+            (0..nb).map(|j| ev.b[(3, j)] * u[j]).sum(),
+            (0..nb).map(|j| ev.b[(4, j)] * u[j]).sum(),
+            (0..nb).map(|j| ev.b[(5, j)] * u[j]).sum(),
+        );
+        let acc = &sol.hinge_acc;
+        let a_h = Vec3::new(acc[0], acc[1], acc[2]);
+        let wd_h = Vec3::new(acc[3], acc[4], acc[5]);
+        let rates = self.chain.phi_rates(s.alpha_dot);
+        let rates_dd = self.chain.phi_rates(&acc[6..]);
+        let (mut vh, mut ah) = (Vec3::ZERO, Vec3::ZERO);
+        (0..self.panels())
+            .map(|i| {
+                let c = ev.centres[i];
+                let r = c - ev.hinge_points[i];
+                let l = ev.hinge_points[i + 1] - ev.hinge_points[i];
+                let (w, wd) = (rates[i], rates_dd[i]);
+                let vrel = vh + Z.cross(r) * w;
+                let arel = ah + Z.cross(r) * wd - r * (w * w);
+                vh = vh + Z.cross(l) * w;
+                ah = ah + Z.cross(l) * wd - l * (w * w);
+                let a = a_h
+                    + wd_h.cross(c)
+                    + omega.cross(omega.cross(c))
+                    + omega.cross(vrel) * 2.0
+                    + arel;
+                let wi = omega + Z * w;
+                let ei = wd_h + Z * wd + omega.cross(Z * w);
+                [a, wi, ei]
+            })
+            .collect()
+    }
+
+    /// Per hinge, hinge components: the force the inboard body applies to panel l (N) and the
+    /// moment the hinge transmits about h_l (N·m).
+    pub fn hinge_loads(&self, y: &[f64], ev: &Eval, sol: &Solution) -> Vec<(Vec3, Vec3)> {
+        let kin = self.panel_accelerations(y, ev, sol);
+        let n = self.panels();
+        let mut out = vec![(Vec3::ZERO, Vec3::ZERO); n];
+        for l in 0..n {
+            let h = ev.hinge_points[l];
+            let (mut f, mut m) = (Vec3::ZERO, Vec3::ZERO);
+            for i in l..n {
+                let [a, w, e] = kin[i];
+                let fi = a * self.chain.panels[i].mass;
+                let ii = self.panel_tensor(i, ev.phi[i]);
+                f = f + fi;
+                m = m + (ev.centres[i] - h).cross(fi) + ii.apply(e) + w.cross(ii.apply(w));
+            }
+            out[l] = (f, m);
+        }
+        out
+    }
+
+    /// Per hinge: the linear impulse (N·s, deployment-plane axes) from the inboard body on
+    /// panel l and the angular impulse (N·m·s) its hinge carries, for a jump of the speeds
+    /// from those of `y` to `u_after`.
+    pub fn hinge_impulses(&self, y: &[f64], u_after: &[f64]) -> Vec<(P2, f64)> {
+        let np = self.positions();
+        let ev = self.evaluate(y);
+        let mut y_after = y.to_vec();
+        y_after[np..].copy_from_slice(u_after);
+        let et = ev.frame.transpose();
+        let before = self.panel_motion(y, &ev);
+        let after = self.panel_motion(&y_after, &ev);
+        let dv: Vec<(Vec3, Vec3)> = before
+            .iter()
+            .zip(&after)
+            .map(|(b, a)| (et.apply(a.1 - b.1), et.apply(a.2 - b.2)))
+            .collect();
+        let n = self.panels();
+        (0..n)
+            .map(|l| {
+                let h = ev.hinge_points[l];
+                let (mut s, mut a) = (Vec3::ZERO, Vec3::ZERO);
+                for i in l..n {
+                    let si = dv[i].0 * self.chain.panels[i].mass;
+                    s = s + si;
+                    a = a
+                        + (ev.centres[i] - h).cross(si)
+                        + self.panel_tensor(i, ev.phi[i]).apply(dv[i].1);
+                }
+                ([s.get(0), s.get(1)], a.get(2))
+            })
+            .collect()
+    }
+
+    /// Per base beam: elastic tip deflection along its axes (u, v, w, m) and twist (rad).
+    pub fn beam_tips(&self, y: &[f64]) -> Vec<[f64; 4]> {
+        let eta = self.view(y).eta;
+        self.base
+            .beams
+            .iter()
+            .map(|b| {
+                let d = combine(&b.tip_shapes, eta);
+                let r = combine(&b.tip_rotations, eta);
+                [
+                    d.dot(b.axes[0]),
+                    d.dot(b.axes[1]),
+                    d.dot(b.axes[2]),
+                    r.dot(b.axes[0]),
+                ]
+            })
+            .collect()
+    }
+
+    /// Per base beam: the force (N) and the moment about its root point (N·m) its parent
+    /// exerts on it, hub components (module doc).
+    pub fn beam_root_loads(&self, y: &[f64], ev: &Eval, sol: &Solution) -> Vec<[f64; 6]> {
+        let s = self.view(y);
+        let (h, m) = (self.hub_dof(), self.modes());
+        let ud = &sol.udot;
+        let (vd, wd) = if h == 6 {
+            (
+                Vec3::new(ud[0], ud[1], ud[2]),
+                Vec3::new(ud[3], ud[4], ud[5]),
+            )
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let eta_dd = &ud[h..h + m];
+        let (wf, wm) = sol.root_wrench;
+        self.base
+            .beams
+            .iter()
+            .map(|b| {
+                let at = b.subtree.at(s.eta);
+                let (mut f, mut mo) = b.subtree.wrench(&at, s.v, s.w, s.eta_dot, vd, wd, eta_dd);
+                if b.carries_array {
+                    f = f + wf;
+                    mo = mo + wm + ev.hinge.cross(wf);
+                }
+                let root = b.root + combine(&b.root_shapes, s.eta);
+                let mb = mo - root.cross(f);
+                [
+                    f.get(0),
+                    f.get(1),
+                    f.get(2),
+                    mb.get(0),
+                    mb.get(1),
+                    mb.get(2),
+                ]
+            })
+            .collect()
+    }
+
+    /// The 3-D part of a sample.
+    fn body_sample(&self, y: &[f64], ev: &Eval, sol: &Solution) -> BodySample {
+        let s = self.view(y);
+        let a = attitude::matrix(s.quat);
+        let (p, l, _) = self.momentum(y);
+        BodySample {
+            hub_position: s.r.0,
+            hub_rotation: attitude::rotation_vector(s.quat).0,
+            hub_velocity: a.apply(s.v).0,
+            hub_rate: a.apply(s.w).0,
+            eta: s.eta.to_vec(),
+            beam_tips: self.beam_tips(y),
+            root_loads: self.beam_root_loads(y, ev, sol),
+            cable_torque: sol.cable_torque.clone(),
+            elastic: self.elastic_energy(y),
+            momentum: p.0,
+            angular_momentum: l.0,
+        }
+    }
+}
+
+impl Engine for Coupled {
+    fn hinges(&self) -> &[Hinge] {
+        &self.chain.hinges
+    }
+    fn positions(&self) -> usize {
+        Coupled::positions(self)
+    }
+    fn alpha_offset(&self) -> usize {
+        Coupled::alpha_offset(self)
+    }
+    fn rate_offset(&self) -> usize {
+        Coupled::rate_offset(self)
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        Coupled::initial_state(self)
+    }
+    fn ideal_cable(&self) -> bool {
+        self.sync == Synchronisation::IdealCable
+    }
+    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
+        Coupled::rhs(self, y, free, dy);
+    }
+    fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses) {
+        let u = Coupled::impact(self, y, free_after);
+        let hinges = self.hinge_impulses(y, &u);
+        let (p0, h0) = self.chain_momentum(y);
+        let mut y_after = y.to_vec();
+        y_after[Coupled::positions(self)..].copy_from_slice(&u);
+        let (p1, h1) = self.chain_momentum(&y_after);
+        let base = Some(((p0 - p1).0, (h0 - h1).0));
+        (
+            u,
+            Impulses {
+                hinges,
+                base,
+                hub_rate: [0.0; 3],
+            },
+        )
+    }
+    fn kinetic_energy(&self, y: &[f64]) -> f64 {
+        Coupled::kinetic_energy(self, y)
+    }
+    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample {
+        let (ev, sol) = self.solve(y, free);
+        let loads = self.hinge_loads(y, &ev, &sol);
+        let s = self.view(y);
+        let cfg = self.chain.configuration(s.alpha);
+        Sample {
+            t,
+            alpha: s.alpha.to_vec(),
+            rate: s.alpha_dot.to_vec(),
+            hub: [0.0; 3],
+            hub_rate: [0.0; 3],
+            force: loads.iter().map(|(f, _)| [f.get(0), f.get(1)]).collect(),
+            moment: loads.iter().map(|(_, m)| m.get(2)).collect(),
+            kinetic: Coupled::kinetic_energy(self, y),
+            spring: self.spring_energy(y),
+            hinges: cfg.hinges,
+            body: Some(Box::new(self.body_sample(y, &ev, &sol))),
+        }
+    }
+}

@@ -1,0 +1,431 @@
+//! One deployment run, whatever the model: the adaptive integration with dense output, the
+//! samples at k / output_rate, the latch events located on the dense output and applied as
+//! impacts, the swing-back scan, and how the run ended. The model is an [`Engine`]: the
+//! planar chain ([`PlanarEngine`], the rigid reference) or the coupled model
+//! ([`super::coupled::Coupled`]).
+
+use super::chain::{Chain, Hinge, PlanarHub, P2};
+use super::events::{self, Crossing};
+use super::integrator::{DenseStep, Dopri5, OdeSystem};
+use super::rosenbrock::Rodas5P;
+use super::swing::SwingTracker;
+use super::Integrator;
+use super::{DeploymentResult, LatchEvent, Latching, RunSettings, RunStatus, Sample};
+use crate::warning::Warning;
+
+/// The impulses of one impact.
+pub(crate) struct Impulses {
+    /// Per hinge: linear impulse from the inboard body on panel i (deployment-plane axes) and
+    /// the angular impulse the hinge carries.
+    pub hinges: Vec<(P2, f64)>,
+    /// The impulse the base receives at the root hinge (coupled model).
+    pub base: Option<([f64; 3], [f64; 3])>,
+    /// The planar free hub's (u̇, v̇, θ̇) after the impact; zero otherwise.
+    pub hub_rate: [f64; 3],
+}
+
+/// A model a deployment run integrates. The state is y = [positions, speeds]; the opening
+/// angles are positions `alpha_offset()..+N`, their rates speeds `rate_offset()..+N`. `free`
+/// flags the hinges (one per panel) that still move.
+pub(crate) trait Engine {
+    /// The hinges, root first.
+    fn hinges(&self) -> &[Hinge];
+    /// Number of position coordinates.
+    fn positions(&self) -> usize;
+    /// Index of α_1 among the positions.
+    fn alpha_offset(&self) -> usize;
+    /// Index of α̇_1 among the speeds.
+    fn rate_offset(&self) -> usize;
+    /// The state at release.
+    fn initial_state(&self) -> Vec<f64>;
+    /// An ideal cable ties every hinge: all lock at the first latch, at their latch angles.
+    fn ideal_cable(&self) -> bool {
+        false
+    }
+    /// dy/dt.
+    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]);
+    /// The plastic impact onto the speeds `free_after` admits: the speeds after, the impulses.
+    fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses);
+    /// Kinetic energy, J.
+    fn kinetic_energy(&self, y: &[f64]) -> f64;
+    /// The sample at time t.
+    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample;
+}
+
+/// The planar chain of [`super::chain`] as an engine: y = [q, q̇].
+pub(crate) struct PlanarEngine<'a>(pub &'a Chain);
+
+impl PlanarEngine<'_> {
+    /// The chain's own free flags: hub coordinates always free.
+    fn full_free(&self, free: &[bool]) -> Vec<bool> {
+        let mut f = vec![true; self.0.hub_dof()];
+        f.extend_from_slice(free);
+        f
+    }
+}
+
+impl Engine for PlanarEngine<'_> {
+    fn hinges(&self) -> &[Hinge] {
+        &self.0.hinges
+    }
+    fn positions(&self) -> usize {
+        self.0.dof()
+    }
+    fn alpha_offset(&self) -> usize {
+        self.0.hub_dof()
+    }
+    fn rate_offset(&self) -> usize {
+        self.0.hub_dof()
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        let (q0, qd0) = self.0.initial_state();
+        q0.iter().chain(&qd0).copied().collect()
+    }
+    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
+        let chain = self.0;
+        let (n, h) = (chain.dof(), chain.hub_dof());
+        let full = self.full_free(free);
+        let d = chain.solve_dynamics(&y[..n], &y[n..], &full, false);
+        for i in 0..n {
+            dy[i] = if i < h || free[i - h] { y[n + i] } else { 0.0 };
+            dy[n + i] = d.qdd[i];
+        }
+    }
+    fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses) {
+        let n = self.0.dof();
+        let (qd, hinges) = self.0.impact(&y[..n], &y[n..], &self.full_free(free_after));
+        let hub_rate = match self.0.hub {
+            PlanarHub::Free { .. } => [qd[0], qd[1], qd[2]],
+            PlanarHub::Fixed => [0.0; 3],
+        };
+        (
+            qd,
+            Impulses {
+                hinges,
+                base: None,
+                hub_rate,
+            },
+        )
+    }
+    fn kinetic_energy(&self, y: &[f64]) -> f64 {
+        let n = self.0.dof();
+        self.0.kinetic_energy(&y[..n], &y[n..])
+    }
+    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample {
+        let chain = self.0;
+        let (n, h) = (chain.dof(), chain.hub_dof());
+        let (q, qd) = (&y[..n], &y[n..]);
+        let d = chain.dynamics(q, qd, &self.full_free(free));
+        let free_hub = matches!(chain.hub, PlanarHub::Free { .. });
+        Sample {
+            t,
+            alpha: q[h..].to_vec(),
+            rate: qd[h..].to_vec(),
+            hub: if free_hub {
+                [q[0], q[1], q[2]]
+            } else {
+                [0.0; 3]
+            },
+            hub_rate: if free_hub {
+                [qd[0], qd[1], qd[2]]
+            } else {
+                [0.0; 3]
+            },
+            force: d.force,
+            moment: d.moment,
+            kinetic: chain.kinetic_energy(q, qd),
+            spring: chain.spring_energy(q),
+            hinges: chain.configuration(q).hinges,
+            body: None,
+        }
+    }
+}
+
+/// The stepper a run uses.
+enum Stepper {
+    Explicit(Dopri5),
+    Implicit(Rodas5P),
+}
+
+impl Stepper {
+    fn new(s: &RunSettings) -> Self {
+        let (rtol, atol) = (s.tolerance, s.tolerance * 1e-2);
+        match s.integrator {
+            Integrator::Explicit => Self::Explicit(Dopri5::new(rtol, atol, f64::INFINITY)),
+            Integrator::Implicit => Self::Implicit(Rodas5P::new(rtol, atol, f64::INFINITY)),
+        }
+    }
+    fn step(&mut self, sys: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_end: f64) -> DenseStep {
+        match self {
+            Self::Explicit(s) => s.step(sys, t, y, t_end),
+            Self::Implicit(s) => s.step(sys, t, y, t_end),
+        }
+    }
+    fn restart(&mut self) {
+        match self {
+            Self::Explicit(s) => s.restart(),
+            Self::Implicit(s) => s.restart(),
+        }
+    }
+    fn evaluations(&self) -> usize {
+        match self {
+            Self::Explicit(s) => s.evaluations,
+            Self::Implicit(s) => s.evaluations,
+        }
+    }
+}
+
+struct System<'a, E: Engine> {
+    engine: &'a E,
+    free: Vec<bool>,
+}
+
+impl<E: Engine> OdeSystem for System<'_, E> {
+    fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        self.engine.rhs(y, &self.free, dy);
+    }
+}
+
+/// The state of a run between steps.
+struct Run<'a, E: Engine> {
+    s: &'a RunSettings,
+    sys: System<'a, E>,
+    latch_angles: Vec<f64>,
+    solver: Stepper,
+    t: f64,
+    y: Vec<f64>,
+    samples: Vec<Sample>,
+    next_k: u64,
+    latches: Vec<LatchEvent>,
+    swing: SwingTracker,
+    buf: Vec<f64>,
+    warnings: Vec<Warning>,
+}
+
+impl<'a, E: Engine> Run<'a, E> {
+    fn new(engine: &'a E, s: &'a RunSettings) -> Self {
+        let hinges = engine.hinges();
+        let y = engine.initial_state();
+        let sys = System {
+            engine,
+            free: vec![true; hinges.len()],
+        };
+        let samples = vec![engine.sample(0.0, &y, &sys.free)];
+        let len = y.len();
+        Self {
+            s,
+            sys,
+            latch_angles: hinges.iter().map(|j| j.latch_angle).collect(),
+            solver: Stepper::new(s),
+            t: 0.0,
+            y,
+            samples,
+            next_k: 1,
+            latches: Vec::new(),
+            swing: SwingTracker::new(hinges.iter().map(|j| j.initial_angle).collect()),
+            buf: vec![0.0; len],
+            warnings: Vec::new(),
+        }
+    }
+
+    fn alpha_range(&self) -> std::ops::Range<usize> {
+        let a = self.sys.engine.alpha_offset();
+        a..a + self.latch_angles.len()
+    }
+
+    /// Some hinge is still free.
+    fn moving(&self) -> bool {
+        self.sys.free.iter().any(|f| *f)
+    }
+
+    /// One accepted step: its samples, the swing-back scan and the earliest latch in it.
+    /// False (and the state left at the step's start) when the step's state is not finite.
+    fn advance(&mut self) -> bool {
+        let off = self.sys.engine.alpha_offset();
+        let y_start = self.y.clone();
+        let step = self
+            .solver
+            .step(&self.sys, &mut self.t, &mut self.y, self.s.end_time);
+        if !self.y.iter().all(|v| v.is_finite()) {
+            self.y.copy_from_slice(&y_start);
+            self.t = step.t0;
+            return false;
+        }
+        let event = events::earliest_latch(&step, off, &self.latch_angles, &self.sys.free);
+        let t_limit = event.map_or(self.t, |e| e.t);
+        self.sample_until(&step, t_limit);
+        self.swing.scan(&step, off, t_limit);
+        match event {
+            None => {
+                let r = self.alpha_range();
+                self.swing.observe(self.t, &self.y[r]);
+            }
+            Some(e) => self.latch(&step, e),
+        }
+        true
+    }
+
+    /// Samples at k / rate within (step.t0, t_limit].
+    fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
+        let r = self.alpha_range();
+        loop {
+            let tk = self.next_k as f64 / self.s.output_rate;
+            if tk > t_limit || tk > self.s.end_time {
+                break;
+            }
+            step.eval(tk, &mut self.buf);
+            self.swing.observe(tk, &self.buf[r.clone()]);
+            self.samples
+                .push(self.sys.engine.sample(tk, &self.buf, &self.sys.free));
+            self.next_k += 1;
+        }
+    }
+
+    /// The latch at crossing `e` of `step`: the state moves to the crossing, the impact
+    /// applies, and samples just before and after are recorded.
+    fn latch(&mut self, step: &DenseStep, e: Crossing) {
+        let engine = self.sys.engine;
+        let off = engine.alpha_offset();
+        let np = engine.positions();
+        step.eval(e.t, &mut self.y);
+        self.t = e.t;
+        let cable = engine.ideal_cable();
+        let all = cable || self.s.latching == Latching::Simultaneous;
+        let mut free_after = self.sys.free.clone();
+        if all {
+            free_after.iter_mut().for_each(|f| *f = false);
+        } else {
+            free_after[e.hinge] = false;
+        }
+        // The hinge that reached its latch angle sits on it; with an ideal cable every hinge
+        // does (the cable law puts them there together, up to the event tolerance).
+        for j in 0..self.latch_angles.len() {
+            if j == e.hinge || (cable && self.sys.free[j]) {
+                self.y[off + j] = self.latch_angles[j];
+            }
+        }
+        if all && !cable {
+            self.bent_lock_warning(e);
+        }
+        let before = engine.sample(e.t, &self.y, &self.sys.free);
+        let energy_before = engine.kinetic_energy(&self.y);
+        let (u_new, impulses) = engine.impact(&self.y, &free_after);
+        let qd_before = self.y[np..].to_vec();
+        self.y[np..].copy_from_slice(&u_new);
+        let ro = engine.rate_offset();
+        let n = self.latch_angles.len();
+        let event = LatchEvent {
+            hinge: e.hinge + 1,
+            locked: (0..n)
+                .filter(|&i| self.sys.free[i] && !free_after[i])
+                .map(|i| i + 1)
+                .collect(),
+            time: e.t,
+            angles: self.y[off..off + n].to_vec(),
+            rates_before: qd_before[ro..ro + n].to_vec(),
+            rates_after: u_new[ro..ro + n].to_vec(),
+            energy_before,
+            energy_after: engine.kinetic_energy(&self.y),
+            impulses: impulses.hinges,
+            hub_rate_after: impulses.hub_rate,
+            q: self.y[..np].to_vec(),
+            qd_before,
+            qd_after: u_new,
+            base_impulse: impulses.base,
+        };
+        self.latches.push(event);
+        self.sys.free = free_after;
+        if self.samples.last().is_none_or(|s| s.t < e.t) {
+            self.samples.push(before);
+        }
+        self.samples
+            .push(engine.sample(e.t, &self.y, &self.sys.free));
+        self.solver.restart();
+    }
+
+    /// Simultaneous latching without a cable locks the array where it stands: the warning
+    /// names the hinge farthest from its latch angle.
+    fn bent_lock_warning(&mut self, e: Crossing) {
+        let off = self.sys.engine.alpha_offset();
+        let worst = (0..self.latch_angles.len())
+            .filter(|&j| self.sys.free[j])
+            .map(|j| (j, self.latch_angles[j] - self.y[off + j]))
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+        if let Some((j, off_by)) = worst {
+            if off_by.abs() > 1e-9 {
+                self.warnings.push(Warning::LocksBent {
+                    t: e.t,
+                    hinge: j + 1,
+                    rad: off_by,
+                });
+            }
+        }
+    }
+
+    fn finish(self, out_of_steps: bool, diverged: bool) -> DeploymentResult {
+        let engine = self.sys.engine;
+        let np = engine.positions();
+        let all_latched = !self.moving();
+        let t = self.t;
+        let status = if diverged {
+            RunStatus::Diverged { t }
+        } else if all_latched {
+            RunStatus::AllLatched
+        } else if out_of_steps && t < self.s.end_time {
+            RunStatus::StepLimit { t }
+        } else {
+            RunStatus::EndTime
+        };
+        let off = engine.alpha_offset();
+        let unlatched: Vec<(usize, f64)> = (0..self.latch_angles.len())
+            .filter(|&i| self.sys.free[i])
+            .map(|i| (i + 1, self.y[off + i]))
+            .collect();
+        let (swing_back, swing_warnings) = self.swing.finish();
+        let mut warnings = self.warnings;
+        warnings.extend(swing_warnings);
+        match status {
+            RunStatus::Diverged { t } => warnings.push(Warning::Diverged { t }),
+            RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
+            RunStatus::AllLatched | RunStatus::EndTime => {}
+        }
+        if !all_latched {
+            warnings.push(Warning::NotLatched {
+                t,
+                hinges: unlatched
+                    .iter()
+                    .map(|&(i, a)| (i, a, self.latch_angles[i - 1]))
+                    .collect(),
+            });
+        }
+        DeploymentResult {
+            samples: self.samples,
+            latches: self.latches,
+            status,
+            all_latched,
+            final_time: t,
+            final_q: self.y[..np].to_vec(),
+            final_qd: self.y[np..].to_vec(),
+            unlatched,
+            swing_back,
+            warnings,
+            evaluations: self.solver.evaluations(),
+        }
+    }
+}
+
+/// Runs `engine` from release until every hinge has latched or the end time (at most
+/// `max_steps` steps).
+pub(crate) fn run<E: Engine>(engine: &E, s: &RunSettings, max_steps: usize) -> DeploymentResult {
+    let mut run = Run::new(engine, s);
+    let mut steps = 0usize;
+    let mut diverged = false;
+    while run.t < s.end_time && run.moving() && steps < max_steps {
+        steps += 1;
+        if !run.advance() {
+            diverged = true;
+            break;
+        }
+    }
+    run.finish(steps >= max_steps, diverged)
+}
