@@ -428,3 +428,71 @@ fn derived_panels_obey_the_ranges_of_given_ones() {
         "give panel_mass",
     );
 }
+
+/// The coupled deployment's keys (issue 11): each bad value is refused with its line, key
+/// and reason, exit 2, nothing written; `base_modes` out of range is clamped with a warning.
+#[test]
+fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
+    let dir = scratch("coupled-keys");
+    let sync = "synchronisation = \"cable\"\n";
+    let cases: [(String, &str, &str, &str); 6] = [
+        (
+            SEED.replace(sync, &format!("{sync}hub = \"free\"\n")),
+            "hub = \"free\"",
+            "deployment.hub",
+            "[hub] motion",
+        ),
+        (
+            SEED.replace("base_modes = 6", "base_modes = -1"),
+            "base_modes = -1",
+            "deployment.base_modes",
+            "0 or more",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}cable_stiffness = 0.0\n")),
+            "cable_stiffness = 0.0",
+            "deployment.cable_stiffness",
+            "positive",
+        ),
+        (
+            SEED.replace(sync, "cable_stiffness = 100.0\n"),
+            "cable_stiffness = 100.0",
+            "deployment.cable_stiffness",
+            "only a cable",
+        ),
+        (
+            SEED.replace("friction = 0.0\n", "friction = 0.0\n\n[[deployment.hinges]]\n[[deployment.hinges]]\nlatch_angle = 3.0\n[[deployment.hinges]]\n"),
+            "synchronisation = \"cable\"",
+            "deployment.synchronisation",
+            "twice as far",
+        ),
+        (
+            SEED.replace("base = \"flexible\"", "base = \"rigid\""),
+            "base_modes = 6",
+            "deployment.base_modes",
+            "rigid base",
+        ),
+    ];
+    for (k, (src, needle, key, reason)) in cases.iter().enumerate() {
+        assert_ne!(src, SEED, "case {k}");
+        let sub = dir.join(format!("case{k}"));
+        std::fs::create_dir_all(&sub).unwrap();
+        let out = run(&sub, "deploy", src, &[]);
+        assert_refused(&sub, &out, line_of(src, needle), key, reason);
+    }
+    // Above the base's count: clamped, with the warning.
+    let sc = Scenario::from_toml_str(
+        &SEED.replace("base_modes = 6", "base_modes = 500"),
+        "s.toml",
+    )
+    .unwrap();
+    let d = sc.deployment.as_ref().unwrap();
+    let mut short = d.clone();
+    short.end_time = 0.5;
+    let (c, r) = flexcraft::deploy::simulate_coupled(&sc.structure, &short).unwrap();
+    assert_eq!(c.modes(), c.base.ritz.dof() - 6);
+    assert!(r
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains("base_modes = 500 is outside")));
+}
