@@ -80,6 +80,9 @@
         el("line", { x1: L, x2: W - R, y1: sy(v), y2: sy(v), "class": "grid" }, svg);
         text(svg, L - 6, sy(v) + 4, fmt(v), "end", "tick");
       });
+      (spec.markers || []).forEach(function (m) {
+        if (m >= view[0] && m <= view[1]) el("line", { x1: sx(m), x2: sx(m), y1: T, y2: H - B, "class": "marker" }, svg);
+      });
       el("rect", { x: L, y: T, width: W - L - R, height: H - T - B, "class": "frame" }, svg);
       text(svg, (L + W - R) / 2, H - 8, spec.xlabel, "middle", "label");
       var yl = text(svg, 14, (T + H - B) / 2, spec.ylabel, "middle", "label");

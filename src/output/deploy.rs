@@ -359,7 +359,8 @@ pub fn write_deploy(
     dir.write("events.json", deploy_json(name, d, c, r) + "\n")?;
     dir.write("deployment.csv", deployment_csv(c, r))?;
 
-    for f in super::figures::deployment_figures(d, r) {
+    let names: Vec<String> = c.base.beams.iter().map(|b| b.name.clone()).collect();
+    for f in super::figures::deployment_figures(d, r, &names) {
         f.draw(dir)?;
     }
     // Snapshots: the chain at up to 9 evenly spaced sample times (and the final state).

@@ -75,18 +75,21 @@ pub struct Figure {
     pub ylabel: &'static str,
     /// Curves.
     pub curves: Vec<Curve>,
+    /// Event times marked by vertical lines (the latches), in x units.
+    pub markers: Vec<f64>,
 }
 
 impl Figure {
     /// plots/STEM.png and .svg.
     pub fn draw(&self, dir: &mut super::OutputDir) -> Result<(), super::OutputError> {
-        super::plot::line_chart(
+        super::plot::line_chart_marked(
             dir,
             &self.stem,
             &self.title,
             (self.xlabel, self.ylabel),
             &self.series(),
             false,
+            &self.markers,
         )
     }
 
@@ -104,12 +107,19 @@ impl Figure {
     }
 }
 
-/// Angles, rates, hinge reaction magnitudes (up to 8 hinges shown) and hub motion.
-pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
+/// Angles, rates, hinge reaction magnitudes (up to 8 hinges shown), the hub's motion, and
+/// for the coupled model every base beam's root force and moment and the first base modal
+/// coordinates; the latches marked on each.
+pub fn deployment_figures(
+    d: &Deployment,
+    r: &DeploymentResult,
+    beam_names: &[String],
+) -> Vec<Figure> {
     let n = d.chain.len();
     let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
     let m = r.samples.len();
     let t = |k: usize| r.samples[k].t;
+    let markers: Vec<f64> = r.latches.iter().map(|e| e.time).collect();
     let per_hinge = |f: &dyn Fn(&Sample, usize) -> f64| -> Vec<Curve> {
         shown
             .iter()
@@ -122,13 +132,10 @@ pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
         xlabel: "t [s]",
         ylabel,
         curves,
+        markers: markers.clone(),
     };
-    let hub: Vec<Curve> = ["u [m]", "v [m]", "θ [rad]"]
-        .iter()
-        .enumerate()
-        .map(|(j, l)| curve(format!("hub {l}"), m, t, |k| r.samples[k].hub[j]))
-        .collect();
-    vec![
+    let body = |k: usize| r.samples[k].body.as_deref();
+    let mut figs = vec![
         fig(
             "angles",
             "opening angles",
@@ -147,13 +154,121 @@ pub fn deployment_figures(d: &Deployment, r: &DeploymentResult) -> Vec<Figure> {
             "|F| [N]",
             per_hinge(&|s, i| s.force[i][0].hypot(s.force[i][1])),
         ),
-        fig(
+    ];
+    if body(0).is_none() {
+        let hub: Vec<Curve> = ["u [m]", "v [m]", "θ [rad]"]
+            .iter()
+            .enumerate()
+            .map(|(j, l)| curve(format!("hub {l}"), m, t, |k| r.samples[k].hub[j]))
+            .collect();
+        figs.push(fig(
             "hub",
             "hub motion in the deployment plane",
             "u, v [m]; θ [rad]",
             hub,
-        ),
-    ]
+        ));
+        return figs;
+    }
+    figs.extend(body_figures(r, beam_names, &markers));
+    figs
+}
+
+/// The coupled model's figures: the hub's position and attitude, every base beam's root
+/// force and moment, the first base modal coordinates.
+fn body_figures(r: &DeploymentResult, beam_names: &[String], markers: &[f64]) -> Vec<Figure> {
+    let m = r.samples.len();
+    let t = |k: usize| r.samples[k].t;
+    let body = |k: usize| r.samples[k].body.as_deref();
+    let fig = |stem: &str, title: &str, ylabel: &'static str, curves| Figure {
+        stem: stem.into(),
+        title: title.into(),
+        xlabel: "t [s]",
+        ylabel,
+        curves,
+        markers: markers.to_vec(),
+    };
+    let mut figs = Vec::new();
+    let comp = |f: &dyn Fn(&crate::deploy::BodySample) -> f64, k: usize| body(k).map_or(0.0, f);
+    let xyz = ["x", "y", "z"];
+    let hub: Vec<Curve> = (0..3)
+        .map(|j| {
+            curve(format!("hub {}", xyz[j]), m, t, |k| {
+                comp(&|b| b.hub_position[j], k)
+            })
+        })
+        .collect();
+    figs.push(fig(
+        "hub",
+        "hub centre of mass (inertial)",
+        "position [m]",
+        hub,
+    ));
+    let rot: Vec<Curve> = (0..3)
+        .map(|j| {
+            curve(format!("rotation {}", xyz[j]), m, t, |k| {
+                comp(&|b| b.hub_rotation[j], k)
+            })
+        })
+        .collect();
+    figs.push(fig(
+        "hub_attitude",
+        "hub attitude (rotation vector, inertial)",
+        "rotation [rad]",
+        rot,
+    ));
+    let beams = body(0).map_or(0, |b| b.root_loads.len());
+    let norm = |l: &[f64]| l.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let names = |b: usize| {
+        beam_names
+            .get(b)
+            .cloned()
+            .unwrap_or_else(|| format!("beam {}", b + 1))
+    };
+    if beams > 0 {
+        let moments: Vec<Curve> = (0..beams)
+            .map(|b| {
+                curve(names(b), m, t, |k| {
+                    comp(&|s| norm(&s.root_loads[b][3..6]), k)
+                })
+            })
+            .collect();
+        figs.push(fig(
+            "root_moments",
+            "beam root moment magnitude (parent on beam)",
+            "|M| [N·m]",
+            moments,
+        ));
+        let forces: Vec<Curve> = (0..beams)
+            .map(|b| {
+                curve(names(b), m, t, |k| {
+                    comp(&|s| norm(&s.root_loads[b][0..3]), k)
+                })
+            })
+            .collect();
+        figs.push(fig(
+            "root_forces",
+            "beam root force magnitude (parent on beam)",
+            "|F| [N]",
+            forces,
+        ));
+    }
+    let modes = body(0).map_or(0, |b| b.eta.len()).min(6);
+    if modes > 0 {
+        let eta: Vec<Curve> = (0..modes)
+            .map(|j| {
+                curve(format!("base mode {}", j + 1), m, t, |k| {
+                    comp(&|s| s.eta[j], k)
+                })
+            })
+            .collect();
+        figs.push(fig(
+            "base_modes",
+            "base modal coordinates (hub-fixed modes)",
+            "η [√kg·m]",
+            eta,
+        ));
+    }
+    figs
 }
 
 /// The paper's figures 2.4–2.7 (every beam's tip deflection and twist, every plate's tip
@@ -171,6 +286,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
             .collect()
     };
     let fig = |stem: String, title: String, ylabel: &'static str, curves| Figure {
+        markers: Vec::new(),
         stem,
         title,
         xlabel: "t after the latch [s]",

@@ -223,6 +223,7 @@ fn draw_chart<DB: DrawingBackend>(
     labels: (&str, &str),
     series: &[Series],
     equal_aspect: bool,
+    markers: &[f64],
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let pts = series.iter().flat_map(|s| s.1.iter());
@@ -273,6 +274,15 @@ fn draw_chart<DB: DrawingBackend>(
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| e.to_string())?;
+    // Event markers (latches): thin grey vertical lines across the plot.
+    for &m in markers.iter().filter(|m| (x0..=x1).contains(*m)) {
+        chart
+            .draw_series(LineSeries::new(
+                [(m, y0 - pad), (m, y1 + pad)],
+                BLACK.mix(0.35).stroke_width(1),
+            ))
+            .map_err(|e| e.to_string())?;
+    }
     for (i, (name, pts)) in series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
         let drawn = chart
@@ -305,12 +315,25 @@ pub fn line_chart(
     series: &[Series],
     equal_aspect: bool,
 ) -> Result<(), OutputError> {
+    line_chart_marked(dir, stem, title, labels, series, equal_aspect, &[])
+}
+
+/// [`line_chart`] with vertical event markers at the given x values.
+pub fn line_chart_marked(
+    dir: &mut OutputDir,
+    stem: &str,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+    equal_aspect: bool,
+    markers: &[f64],
+) -> Result<(), OutputError> {
     register_font();
     png_and_svg!(
         dir,
         format!("plots/{stem}"),
         (1000, 600),
-        |root| draw_chart(root, title, labels, series, equal_aspect)
+        |root| draw_chart(root, title, labels, series, equal_aspect, markers)
     );
     Ok(())
 }

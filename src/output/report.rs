@@ -50,7 +50,8 @@ fn plot(f: &Figure) -> String {
                    "y": y.iter().copied().map(round7).collect::<Vec<_>>()})
         })
         .collect();
-    let spec = json!({"title": f.title, "xlabel": f.xlabel, "ylabel": f.ylabel, "series": s});
+    let spec = json!({"title": f.title, "xlabel": f.xlabel, "ylabel": f.ylabel, "series": s,
+                      "markers": f.markers.iter().copied().map(round7).collect::<Vec<_>>()});
     format!(
         "<figure class=\"plot\" data-title=\"{}\"><script type=\"application/json\">{}</script></figure>\n",
         esc(&f.title),
@@ -510,7 +511,14 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
     for w in &r.warnings {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
-    for f in super::figures::deployment_figures(d, r) {
+    let names: Vec<String> = sim
+        .coupled
+        .base
+        .beams
+        .iter()
+        .map(|b| b.name.clone())
+        .collect();
+    for f in super::figures::deployment_figures(d, r, &names) {
         o.push_str(&plot(&f));
     }
     o.push_str("</section>\n");
