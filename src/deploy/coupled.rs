@@ -806,9 +806,25 @@ fn solve_admissible(m: &Mat<f64>, z: &Mat<f64>, b: &[f64]) -> Vec<f64> {
     if k == 0 {
         return vec![0.0; n];
     }
-    let mz = m * z;
-    let zmz = z.transpose() * &mz;
-    let mut rhs = Mat::from_fn(k, 1, |i, _| (0..n).map(|j| z[(j, i)] * b[j]).sum::<f64>());
+    // Z is sparse (unit columns for the hub and base speeds and the free hinges, one cable
+    // column): ZᵀMZ by loops over its non-zeros.
+    let nz: Vec<Vec<(usize, f64)>> = (0..k)
+        .map(|c| {
+            (0..n)
+                .filter(|&r| z[(r, c)] != 0.0)
+                .map(|r| (r, z[(r, c)]))
+                .collect()
+        })
+        .collect();
+    let zmz = Mat::from_fn(k, k, |a, c| {
+        nz[a]
+            .iter()
+            .map(|&(i, za)| za * nz[c].iter().map(|&(j, zc)| m[(i, j)] * zc).sum::<f64>())
+            .sum::<f64>()
+    });
+    let mut rhs = Mat::from_fn(k, 1, |i, _| {
+        nz[i].iter().map(|&(j, zj)| zj * b[j]).sum::<f64>()
+    });
     match zmz.llt(Side::Lower) {
         Ok(llt) => {
             faer::linalg::solvers::Solve::solve_in_place(&llt, rhs.as_mut());

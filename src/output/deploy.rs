@@ -152,6 +152,7 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "latches": latches,
         "all_latched": r.all_latched,
         "final_time": r.final_time,
+        "rhs_evaluations": r.evaluations,
         "unlatched": r.unlatched.iter().map(|(h, a)| json!({"hinge": h, "angle": a})).collect::<Vec<_>>(),
         "swing_back": r.swing_back.iter().map(|s| json!({"hinge": s.hinge, "first_time": s.first_time, "min_angle": s.min_angle})).collect::<Vec<_>>(),
         "warnings": r.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),

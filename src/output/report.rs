@@ -482,11 +482,11 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
          <div class=\"stage\"></div><p class=\"note\">Deployment plane: u along the wing's length axis (right), v along its normal (up); the dark dot is the hub's centre of mass, red dots the hinges and the tip.</p></div>",
         embed(&spec)
     );
-    o.push_str("<h3>Latch events</h3><table id=\"latches\"><tr><th>latch</th><th>hinge</th><th>t [s]</th><th>kinetic energy before [J]</th><th>after [J]</th><th>lost [J]</th></tr>\n");
+    o.push_str("<h3>Latch events</h3><table id=\"latches\"><tr><th>latch</th><th>hinge</th><th>t [s]</th><th>kinetic energy before [J]</th><th>after [J]</th><th>lost [J]</th><th>impulse on the base at the root hinge, hub axes: force [N·s], moment [N·m·s]</th></tr>\n");
     for (i, e) in r.latches.iter().enumerate() {
         let _ = writeln!(
             o,
-            "<tr><td>{}</td><td>{}</td>{}{}{}<td>{:.6e}</td></tr>",
+            "<tr><td>{}</td><td>{}</td>{}{}{}<td>{:.6e}</td><td>{}</td></tr>",
             i + 1,
             e.hinge,
             keyed(
@@ -504,7 +504,11 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
                 e.energy_after,
                 format!("{:.6e}", e.energy_after)
             ),
-            e.energy_before - e.energy_after
+            e.energy_before - e.energy_after,
+            e.base_impulse.map_or_else(String::new, |(f, m)| format!(
+                "[{:.4e}, {:.4e}, {:.4e}], [{:.4e}, {:.4e}, {:.4e}]",
+                f[0], f[1], f[2], m[0], m[1], m[2]
+            ))
         );
     }
     o.push_str("</table>\n");
@@ -563,6 +567,21 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
             "difference [J]",
             "/handover/energy_lost",
             h.energy_before - h.energy_after,
+        ),
+        (
+            "elastic energy of the base before [J]",
+            "/handover/elastic_energy_before",
+            h.elastic_energy_before,
+        ),
+        (
+            "elastic energy after [J]",
+            "/handover/elastic_energy_after",
+            h.elastic_energy_after,
+        ),
+        (
+            "projection residual, kinetic + elastic [J]",
+            "/handover/projection_residual",
+            (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
         ),
         (
             "share of the hand-over energy in the kept modes",
