@@ -356,6 +356,17 @@ pub fn modal_velocities(modal: &ModalAnalysis, b: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// The final latch of a run in which every hinge latched.
+fn final_latch(result: &DeploymentResult) -> Result<&LatchEvent, ResponseError> {
+    match result.latches.last() {
+        Some(ev) if result.all_latched => Ok(ev),
+        _ => Err(ResponseError::NotLatched {
+            hinges: result.unlatched.iter().map(|u| u.0).collect(),
+            time: result.final_time,
+        }),
+    }
+}
+
 /// Hands the motion over at the final latch (see the module documentation).
 pub fn hand_over(
     model: &RitzModel,
@@ -364,15 +375,7 @@ pub fn hand_over(
     result: &DeploymentResult,
     method: HandoverMethod,
 ) -> Result<Handover, ResponseError> {
-    let last = match result.latches.last() {
-        Some(ev) if result.all_latched => ev,
-        _ => {
-            return Err(ResponseError::NotLatched {
-                hinges: result.unlatched.iter().map(|u| u.0).collect(),
-                time: result.final_time,
-            })
-        }
-    };
+    let last = final_latch(result)?;
     let view = PlateView::find(model, &deployment.plate)?;
     let st = &model.structure;
     let chain = &deployment.chain;
@@ -476,15 +479,7 @@ pub fn hand_over_coupled(
     result: &DeploymentResult,
     method: HandoverMethod,
 ) -> Result<Handover, ResponseError> {
-    let last = match result.latches.last() {
-        Some(ev) if result.all_latched => ev,
-        _ => {
-            return Err(ResponseError::NotLatched {
-                hinges: result.unlatched.iter().map(|u| u.0).collect(),
-                time: result.final_time,
-            })
-        }
-    };
+    let last = final_latch(result)?;
     let view = PlateView::find(model, &deployment.plate)?;
     let n = model.dof();
     let y: Vec<f64> = result

@@ -2,10 +2,9 @@
 //! system) against independent truths: the planar chain of `deploy::chain` in the rigid
 //! limit, and conservation laws on an elastic base.
 
-use flexcraft::deploy::base::{panel_inertia, BaseKind, BaseModel};
-use flexcraft::deploy::chain::{Chain, PlanarHub};
+use flexcraft::deploy::base::BaseKind;
 use flexcraft::deploy::coupled::{Coupled, Synchronisation};
-use flexcraft::deploy::simulate;
+use flexcraft::deploy::{simulate, Deployment};
 use flexcraft::scenario::Scenario;
 
 fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
@@ -14,32 +13,15 @@ fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
     Scenario::from_toml_str(&src, &path).unwrap()
 }
 
-/// The coupled model of a scenario's deployment (hub motion from `[hub] motion`, no cable).
+/// The coupled model of a scenario's deployment (hub motion from `[hub] motion`, no cable,
+/// the given base).
 pub fn coupled(sc: &Scenario, kind: BaseKind) -> Coupled {
-    let d = sc.deployment.as_ref().unwrap();
-    let st = &sc.structure;
-    let plate = st
-        .plates()
-        .iter()
-        .position(|p| p.name() == d.plate)
-        .unwrap();
-    let width = st.plates()[plate].width();
-    let chain = Chain {
-        hub: PlanarHub::Fixed,
-        root: [0.0, 0.0],
-        ..d.chain.clone()
+    let d = Deployment {
+        base: kind,
+        synchronisation: Synchronisation::None,
+        ..sc.deployment.clone().unwrap()
     };
-    let panel = chain
-        .panels
-        .iter()
-        .map(|p| panel_inertia(p.mass, width, p.inertia))
-        .collect();
-    Coupled {
-        base: BaseModel::new(st, plate, kind).unwrap(),
-        chain,
-        panel_inertia: panel,
-        sync: Synchronisation::None,
-    }
+    d.coupled(&sc.structure).unwrap()
 }
 
 /// A hub-only base (no beams) is the rigid planar problem: the coupled model's latch times
