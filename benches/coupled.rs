@@ -20,9 +20,9 @@
 //! settings in a fresh process).
 
 use criterion::{Bencher, Criterion, SamplingMode};
-use flexcraft::deploy::base::{panel_inertia, BaseKind, BaseModel};
-use flexcraft::deploy::chain::{Chain, PlanarHub};
+use flexcraft::deploy::base::BaseKind;
 use flexcraft::deploy::coupled::{Coupled, CoupledRun, Synchronisation};
+use flexcraft::deploy::Deployment;
 use flexcraft::faer::{Mat, Side};
 use flexcraft::Scenario;
 use std::collections::BTreeMap;
@@ -84,33 +84,14 @@ fn scenario(terms: (usize, usize, usize), panels: usize, stiffness: Option<f64>)
     Scenario::from_toml_str(&src, "seed.toml").expect("scenario")
 }
 
-/// The coupled model of a scenario's deployment with `modes` base modes (as
-/// tests/suite/coupled.rs builds it).
+/// The coupled model of a scenario's deployment with `modes` base modes.
 fn coupled(sc: &Scenario, modes: usize, sync: Synchronisation) -> Coupled {
-    let d = sc.deployment.as_ref().expect("[deployment]");
-    let st = &sc.structure;
-    let plate = st
-        .plates()
-        .iter()
-        .position(|p| p.name() == d.plate)
-        .expect("plate");
-    let width = st.plates()[plate].width();
-    let chain = Chain {
-        hub: PlanarHub::Fixed,
-        root: [0.0, 0.0],
-        ..d.chain.clone()
+    let d = Deployment {
+        base: BaseKind::Flexible { modes: Some(modes) },
+        synchronisation: sync,
+        ..sc.deployment.clone().expect("[deployment]")
     };
-    let panel = chain
-        .panels
-        .iter()
-        .map(|p| panel_inertia(p.mass, width, p.inertia))
-        .collect();
-    let c = Coupled {
-        base: BaseModel::new(st, plate, BaseKind::Flexible { modes: Some(modes) }).expect("base"),
-        chain,
-        panel_inertia: panel,
-        sync,
-    };
+    let c = d.coupled(&sc.structure).expect("coupled model");
     assert_eq!(c.modes(), modes, "the base has fewer modes than asked");
     c
 }

@@ -166,6 +166,16 @@ pub const CABLE_STIFFNESS: Limit = Limit {
     open_hi: false,
     unit: "N·m/rad",
 };
+/// Compliant latch stiffness.
+pub const LATCH_STIFFNESS: Limit = Limit {
+    lo: 0.0,
+    hi: 1e12,
+    open_lo: true,
+    open_hi: false,
+    unit: "N·m/rad",
+};
+/// Compliant latch damping.
+pub const LATCH_DAMPING: Limit = closed(0.0, 1e9, "N·m·s/rad");
 /// Initial hinge rate.
 pub const RATE: Limit = closed(-100.0, 100.0, "rad/s");
 /// Panel moment of inertia about its hinge-parallel centroidal axis.

@@ -8,6 +8,7 @@ mod suite {
     pub mod beam_functions;
     pub mod cli;
     pub mod common;
+    pub mod compliant_latch;
     pub mod coupled;
     pub mod coupled_limits;
     pub mod coupled_maximal;

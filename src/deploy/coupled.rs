@@ -52,6 +52,17 @@ pub enum Synchronisation {
     ElasticCable(f64),
 }
 
+/// A compliant latch per hinge (MODEL.md §3.2, "Compliant latch"): once hinge j has been
+/// captured (the first time it reaches its latch angle α_j^L while opening) its moment gains
+/// −k_j (α_j − α_j^L) − c_j α̇_j for good; the hinge spring keeps acting.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompliantLatch {
+    /// k_j, N·m/rad.
+    pub stiffness: Vec<f64>,
+    /// c_j, N·m·s/rad.
+    pub damping: Vec<f64>,
+}
+
 /// The coupled system.
 #[derive(Debug)]
 pub struct Coupled {
@@ -63,6 +74,8 @@ pub struct Coupled {
     pub panel_inertia: Vec<[f64; 3]>,
     /// Cable synchronisation.
     pub sync: Synchronisation,
+    /// Compliant latches (`None`: rigid latches, plastic impacts).
+    pub latch: Option<CompliantLatch>,
 }
 
 /// A state split into its parts (slices of y = [positions, speeds]).
@@ -579,10 +592,53 @@ impl Coupled {
 
     /// Accelerations for the hinges flagged free, and the loads.
     pub fn solve(&self, y: &[f64], free: &[bool]) -> (Eval, Solution) {
-        let ev = self.evaluate(y);
+        self.solve_captured(y, free, &vec![false; self.panels()])
+    }
+
+    /// [`Coupled::solve`] with the compliant latches of the hinges flagged `captured` acting.
+    pub fn solve_captured(&self, y: &[f64], free: &[bool], captured: &[bool]) -> (Eval, Solution) {
+        let ev = self.evaluate_captured(y, captured);
         let udot = self.accelerations(&ev, free);
         let sol = self.loads(y, &ev, udot, free);
         (ev, sol)
+    }
+
+    /// [`Coupled::evaluate`] with the latch moments of the captured hinges in the forces.
+    fn evaluate_captured(&self, y: &[f64], captured: &[bool]) -> Eval {
+        let mut ev = self.evaluate(y);
+        let nb = self.rate_offset();
+        for (j, m) in self.latch_moments(y, captured).into_iter().enumerate() {
+            ev.force[nb + j] += m;
+        }
+        ev
+    }
+
+    /// The compliant latches' moments on the hinges, −k_j (α_j − α_j^L) − c_j α̇_j for the
+    /// captured ones, zero otherwise, N·m.
+    pub fn latch_moments(&self, y: &[f64], captured: &[bool]) -> Vec<f64> {
+        let s = self.view(y);
+        (0..self.panels())
+            .map(|j| match &self.latch {
+                Some(l) if captured.get(j).copied().unwrap_or(false) => {
+                    let a = s.alpha[j] - self.chain.hinges[j].latch_angle;
+                    -l.stiffness[j] * a - l.damping[j] * s.alpha_dot[j]
+                }
+                _ => 0.0,
+            })
+            .collect()
+    }
+
+    /// Elastic energy of the captured latches' springs, ½ Σ k_j (α_j − α_j^L)², J.
+    pub fn latch_energy(&self, y: &[f64], captured: &[bool]) -> f64 {
+        let s = self.view(y);
+        let Some(l) = &self.latch else { return 0.0 };
+        (0..self.panels())
+            .filter(|&j| captured.get(j).copied().unwrap_or(false))
+            .map(|j| {
+                let a = s.alpha[j] - self.chain.hinges[j].latch_angle;
+                0.5 * l.stiffness[j] * a * a
+            })
+            .sum()
     }
 
     /// u̇ on the admissible speeds of the hinges flagged free: (ZᵀMZ) ẇ = Zᵀ(Q − c), u̇ = Z ẇ.
@@ -752,7 +808,13 @@ impl Coupled {
 
     /// dy/dt for the hinges flagged free.
     pub fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
-        let udot = self.accelerations(&self.evaluate(y), free);
+        self.rhs_captured(y, free, &vec![false; self.panels()], dy);
+    }
+
+    /// dy/dt for the hinges flagged free, the compliant latches of those flagged `captured`
+    /// acting.
+    pub fn rhs_captured(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
+        let udot = self.accelerations(&self.evaluate_captured(y, captured), free);
         let s = self.view(y);
         let np = self.positions();
         let (h, m) = (self.hub_dof(), self.modes());
@@ -934,6 +996,10 @@ impl Coupled {
             output_rate: 1.0 / end_time,
             tolerance: tol,
             integrator: super::Integrator::Explicit,
+            settle_time: self
+                .latch
+                .as_ref()
+                .map(|l| super::settle_time_default(&self.chain, &l.stiffness)),
         };
         let r = super::run::run(self, &settings, super::MAX_STEPS);
         let latches = r

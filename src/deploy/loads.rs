@@ -222,8 +222,11 @@ impl Engine for Coupled {
     fn ideal_cable(&self) -> bool {
         self.sync == Synchronisation::IdealCable
     }
-    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
-        Coupled::rhs(self, y, free, dy);
+    fn compliant(&self) -> bool {
+        self.latch.is_some()
+    }
+    fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
+        self.rhs_captured(y, free, captured, dy);
     }
     fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses) {
         let u = Coupled::impact(self, y, free_after);
@@ -245,8 +248,8 @@ impl Engine for Coupled {
     fn kinetic_energy(&self, y: &[f64]) -> f64 {
         Coupled::kinetic_energy(self, y)
     }
-    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample {
-        let (ev, sol) = self.solve(y, free);
+    fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample {
+        let (ev, sol) = self.solve_captured(y, free, captured);
         let loads = self.hinge_loads(y, &ev, &sol);
         let s = self.view(y);
         let cfg = self.chain.configuration(s.alpha);
@@ -262,6 +265,8 @@ impl Engine for Coupled {
             spring: self.spring_energy(y),
             hinges: cfg.hinges,
             body: Some(Box::new(self.body_sample(y, &ev, &sol))),
+            latch_moment: self.latch_moments(y, captured),
+            latch_energy: self.latch_energy(y, captured),
         }
     }
 }

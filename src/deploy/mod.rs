@@ -67,6 +67,8 @@ pub struct Deployment {
     pub synchronisation: Synchronisation,
     /// The time integrator.
     pub integrator: Integrator,
+    /// How hinges latch.
+    pub latch: LatchModel,
 }
 
 /// The time integrator of a deployment run.
@@ -82,6 +84,39 @@ pub enum Integrator {
     Implicit,
 }
 
+/// How a hinge latches.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum LatchModel {
+    /// A perfectly plastic impact of the whole system (the paper's; default).
+    #[default]
+    Rigid,
+    /// A spring–damper that captures the hinge at its latch angle for good.
+    Compliant {
+        /// Per hinge, N·m/rad.
+        stiffness: Vec<f64>,
+        /// Per hinge, N·m·s/rad.
+        damping: Vec<f64>,
+        /// How long the run continues after the last capture, s (`None`: the default of
+        /// [`settle_time`]).
+        settle_time: Option<f64>,
+    },
+}
+
+/// The default time the deployment continues after the last capture: ten periods of the
+/// softest latch on its panel alone (ω = √(k / (I + m l²/4))), so that the latch transients
+/// have decayed by the hand-over when c gives them any damping.
+pub fn settle_time_default(chain: &Chain, stiffness: &[f64]) -> f64 {
+    chain
+        .panels
+        .iter()
+        .zip(stiffness)
+        .map(|(p, k)| {
+            let j = p.inertia + 0.25 * p.mass * p.length * p.length;
+            10.0 * 2.0 * std::f64::consts::PI * (j / k).sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
 /// What a run needs besides the model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunSettings {
@@ -95,6 +130,8 @@ pub struct RunSettings {
     pub tolerance: f64,
     /// The time integrator.
     pub integrator: Integrator,
+    /// With compliant latches: how long the run continues after the last capture, s.
+    pub settle_time: Option<f64>,
 }
 
 /// The three-dimensional state of the coupled model at a sample (hub and base quantities;
@@ -152,6 +189,21 @@ pub struct Sample {
     pub hinges: Vec<P2>,
     /// The coupled model's 3-D state (`None` for the planar chain).
     pub body: Option<Box<BodySample>>,
+    /// Compliant latches: the latch moment on each hinge, N·m (zero before capture).
+    pub latch_moment: Vec<f64>,
+    /// Compliant latches: the latch springs' energy, J.
+    pub latch_energy: f64,
+}
+
+/// A compliant latch capturing its hinge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Capture {
+    /// Time, s.
+    pub time: f64,
+    /// The hinge (1-based).
+    pub hinge: usize,
+    /// Every hinge's opening rate at the capture, rad/s.
+    pub rates: Vec<f64>,
 }
 
 /// One latch event.
@@ -217,8 +269,10 @@ pub enum RunStatus {
 pub struct DeploymentResult {
     /// Samples at k/output_rate and at every event.
     pub samples: Vec<Sample>,
-    /// Latch events in time order.
+    /// Latch events in time order (rigid latches).
     pub latches: Vec<LatchEvent>,
+    /// Captures in time order (compliant latches).
+    pub captures: Vec<Capture>,
     /// How the run ended.
     pub status: RunStatus,
     /// Every hinge locked (the same as `status == RunStatus::AllLatched`).
@@ -307,6 +361,16 @@ impl Deployment {
             output_rate: self.output_rate,
             tolerance: self.tolerance,
             integrator: self.integrator,
+            settle_time: match &self.latch {
+                LatchModel::Rigid => None,
+                LatchModel::Compliant {
+                    stiffness,
+                    settle_time,
+                    ..
+                } => {
+                    Some(settle_time.unwrap_or_else(|| settle_time_default(&self.chain, stiffness)))
+                }
+            },
         }
     }
 
@@ -340,6 +404,15 @@ impl Deployment {
             chain,
             panel_inertia,
             sync: self.synchronisation,
+            latch: match &self.latch {
+                LatchModel::Rigid => None,
+                LatchModel::Compliant {
+                    stiffness, damping, ..
+                } => Some(coupled::CompliantLatch {
+                    stiffness: stiffness.clone(),
+                    damping: damping.clone(),
+                }),
+            },
         })
     }
 }

@@ -10,7 +10,7 @@ use super::integrator::{DenseStep, Dopri5, OdeSystem};
 use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
 use super::Integrator;
-use super::{DeploymentResult, LatchEvent, Latching, RunSettings, RunStatus, Sample};
+use super::{Capture, DeploymentResult, LatchEvent, Latching, RunSettings, RunStatus, Sample};
 use crate::warning::Warning;
 
 /// The impulses of one impact.
@@ -42,14 +42,18 @@ pub(crate) trait Engine {
     fn ideal_cable(&self) -> bool {
         false
     }
-    /// dy/dt.
-    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]);
+    /// The hinges latch compliantly (captured, no impact).
+    fn compliant(&self) -> bool {
+        false
+    }
+    /// dy/dt; `captured` flags the hinges whose compliant latch acts.
+    fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]);
     /// The plastic impact onto the speeds `free_after` admits: the speeds after, the impulses.
     fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses);
     /// Kinetic energy, J.
     fn kinetic_energy(&self, y: &[f64]) -> f64;
     /// The sample at time t.
-    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample;
+    fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample;
 }
 
 /// The planar chain of [`super::chain`] as an engine: y = [q, q̇].
@@ -81,7 +85,7 @@ impl Engine for PlanarEngine<'_> {
         let (q0, qd0) = self.0.initial_state();
         q0.iter().chain(&qd0).copied().collect()
     }
-    fn rhs(&self, y: &[f64], free: &[bool], dy: &mut [f64]) {
+    fn rhs(&self, y: &[f64], free: &[bool], _captured: &[bool], dy: &mut [f64]) {
         let chain = self.0;
         let (n, h) = (chain.dof(), chain.hub_dof());
         let full = self.full_free(free);
@@ -111,7 +115,7 @@ impl Engine for PlanarEngine<'_> {
         let n = self.0.dof();
         self.0.kinetic_energy(&y[..n], &y[n..])
     }
-    fn sample(&self, t: f64, y: &[f64], free: &[bool]) -> Sample {
+    fn sample(&self, t: f64, y: &[f64], free: &[bool], _captured: &[bool]) -> Sample {
         let chain = self.0;
         let (n, h) = (chain.dof(), chain.hub_dof());
         let (q, qd) = (&y[..n], &y[n..]);
@@ -137,6 +141,8 @@ impl Engine for PlanarEngine<'_> {
             spring: chain.spring_energy(q),
             hinges: chain.configuration(q).hinges,
             body: None,
+            latch_moment: vec![0.0; chain.len()],
+            latch_energy: 0.0,
         }
     }
 }
@@ -178,11 +184,23 @@ impl Stepper {
 struct System<'a, E: Engine> {
     engine: &'a E,
     free: Vec<bool>,
+    captured: Vec<bool>,
+}
+
+impl<E: Engine> System<'_, E> {
+    /// Hinges that may still reach their latch angle: free and not captured.
+    fn open(&self) -> Vec<bool> {
+        self.free
+            .iter()
+            .zip(&self.captured)
+            .map(|(f, c)| *f && !*c)
+            .collect()
+    }
 }
 
 impl<E: Engine> OdeSystem for System<'_, E> {
     fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
-        self.engine.rhs(y, &self.free, dy);
+        self.engine.rhs(y, &self.free, &self.captured, dy);
     }
 }
 
@@ -197,6 +215,7 @@ struct Run<'a, E: Engine> {
     samples: Vec<Sample>,
     next_k: u64,
     latches: Vec<LatchEvent>,
+    captures: Vec<Capture>,
     swing: SwingTracker,
     buf: Vec<f64>,
     warnings: Vec<Warning>,
@@ -209,8 +228,9 @@ impl<'a, E: Engine> Run<'a, E> {
         let sys = System {
             engine,
             free: vec![true; hinges.len()],
+            captured: vec![false; hinges.len()],
         };
-        let samples = vec![engine.sample(0.0, &y, &sys.free)];
+        let samples = vec![engine.sample(0.0, &y, &sys.free, &sys.captured)];
         let len = y.len();
         Self {
             s,
@@ -222,6 +242,7 @@ impl<'a, E: Engine> Run<'a, E> {
             samples,
             next_k: 1,
             latches: Vec::new(),
+            captures: Vec::new(),
             swing: SwingTracker::new(hinges.iter().map(|j| j.initial_angle).collect()),
             buf: vec![0.0; len],
             warnings: Vec::new(),
@@ -233,9 +254,31 @@ impl<'a, E: Engine> Run<'a, E> {
         a..a + self.latch_angles.len()
     }
 
-    /// Some hinge is still free.
+    /// Some hinge has not latched (or been captured) yet.
     fn moving(&self) -> bool {
-        self.sys.free.iter().any(|f| *f)
+        self.sys.open().iter().any(|f| *f)
+    }
+
+    /// The run goes on: a hinge has not latched, or the captured latches are settling.
+    fn active(&self) -> bool {
+        self.moving() || self.t < self.settle_end()
+    }
+
+    /// With compliant latches, the time the run ends after the last capture.
+    fn settle_end(&self) -> f64 {
+        match (self.s.settle_time, self.captures.last()) {
+            (Some(d), Some(c)) => (c.time + d).min(self.s.end_time),
+            _ => f64::NEG_INFINITY,
+        }
+    }
+
+    /// The end of the next step: the settling's end once every hinge is captured.
+    fn t_stop(&self) -> f64 {
+        if self.moving() {
+            self.s.end_time
+        } else {
+            self.settle_end()
+        }
     }
 
     /// One accepted step: its samples, the swing-back scan and the earliest latch in it.
@@ -243,15 +286,16 @@ impl<'a, E: Engine> Run<'a, E> {
     fn advance(&mut self) -> bool {
         let off = self.sys.engine.alpha_offset();
         let y_start = self.y.clone();
+        let t_stop = self.t_stop();
         let step = self
             .solver
-            .step(&self.sys, &mut self.t, &mut self.y, self.s.end_time);
+            .step(&self.sys, &mut self.t, &mut self.y, t_stop);
         if !self.y.iter().all(|v| v.is_finite()) {
             self.y.copy_from_slice(&y_start);
             self.t = step.t0;
             return false;
         }
-        let event = events::earliest_latch(&step, off, &self.latch_angles, &self.sys.free);
+        let event = events::earliest_latch(&step, off, &self.latch_angles, &self.sys.open());
         let t_limit = event.map_or(self.t, |e| e.t);
         self.sample_until(&step, t_limit);
         self.swing.scan(&step, off, t_limit);
@@ -260,9 +304,40 @@ impl<'a, E: Engine> Run<'a, E> {
                 let r = self.alpha_range();
                 self.swing.observe(self.t, &self.y[r]);
             }
+            Some(e) if self.sys.engine.compliant() => self.capture(&step, e),
             Some(e) => self.latch(&step, e),
         }
         true
+    }
+
+    /// A compliant latch captures hinge `e.hinge` (every open hinge with an ideal cable) at
+    /// the crossing: no velocity jump; the state moves to the crossing and the integration
+    /// restarts with the latch's moment acting.
+    fn capture(&mut self, step: &DenseStep, e: Crossing) {
+        let engine = self.sys.engine;
+        let off = engine.alpha_offset();
+        let ro = engine.positions() + engine.rate_offset();
+        step.eval(e.t, &mut self.y);
+        self.t = e.t;
+        let open = self.sys.open();
+        let all = engine.ideal_cable() || self.s.latching == Latching::Simultaneous;
+        for j in 0..self.latch_angles.len() {
+            if open[j] && (all || j == e.hinge) {
+                self.sys.captured[j] = true;
+                self.captures.push(Capture {
+                    time: e.t,
+                    hinge: j + 1,
+                    rates: self.y[ro..ro + self.latch_angles.len()].to_vec(),
+                });
+            }
+        }
+        // The hinge sits on its latch angle (to the event tolerance): put it there exactly.
+        self.y[off + e.hinge] = self.latch_angles[e.hinge];
+        if self.samples.last().is_none_or(|s| s.t < e.t) {
+            self.samples
+                .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
+        }
+        self.solver.restart();
     }
 
     /// Samples at k / rate within (step.t0, t_limit].
@@ -275,8 +350,12 @@ impl<'a, E: Engine> Run<'a, E> {
             }
             step.eval(tk, &mut self.buf);
             self.swing.observe(tk, &self.buf[r.clone()]);
-            self.samples
-                .push(self.sys.engine.sample(tk, &self.buf, &self.sys.free));
+            self.samples.push(self.sys.engine.sample(
+                tk,
+                &self.buf,
+                &self.sys.free,
+                &self.sys.captured,
+            ));
             self.next_k += 1;
         }
     }
@@ -307,7 +386,7 @@ impl<'a, E: Engine> Run<'a, E> {
         if all && !cable {
             self.bent_lock_warning(e);
         }
-        let before = engine.sample(e.t, &self.y, &self.sys.free);
+        let before = engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured);
         let energy_before = engine.kinetic_energy(&self.y);
         let (u_new, impulses) = engine.impact(&self.y, &free_after);
         let qd_before = self.y[np..].to_vec();
@@ -339,7 +418,7 @@ impl<'a, E: Engine> Run<'a, E> {
             self.samples.push(before);
         }
         self.samples
-            .push(engine.sample(e.t, &self.y, &self.sys.free));
+            .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
         self.solver.restart();
     }
 
@@ -377,8 +456,9 @@ impl<'a, E: Engine> Run<'a, E> {
             RunStatus::EndTime
         };
         let off = engine.alpha_offset();
+        let open = self.sys.open();
         let unlatched: Vec<(usize, f64)> = (0..self.latch_angles.len())
-            .filter(|&i| self.sys.free[i])
+            .filter(|&i| open[i])
             .map(|i| (i + 1, self.y[off + i]))
             .collect();
         let (swing_back, swing_warnings) = self.swing.finish();
@@ -401,6 +481,7 @@ impl<'a, E: Engine> Run<'a, E> {
         DeploymentResult {
             samples: self.samples,
             latches: self.latches,
+            captures: self.captures,
             status,
             all_latched,
             final_time: t,
@@ -420,7 +501,7 @@ pub(crate) fn run<E: Engine>(engine: &E, s: &RunSettings, max_steps: usize) -> D
     let mut run = Run::new(engine, s);
     let mut steps = 0usize;
     let mut diverged = false;
-    while run.t < s.end_time && run.moving() && steps < max_steps {
+    while run.t < s.end_time && run.active() && steps < max_steps {
         steps += 1;
         if !run.advance() {
             diverged = true;

@@ -95,6 +95,27 @@ pub fn peak_hinge_reactions(r: &DeploymentResult) -> Value {
     )
 }
 
+/// Per hinge, the largest compliant-latch moment magnitude (N·m) over the samples and its
+/// time (empty with rigid latches).
+pub fn peak_latch_moments(r: &DeploymentResult) -> Value {
+    if r.captures.is_empty() {
+        return Value::Array(Vec::new());
+    }
+    let n = r.samples.first().map_or(0, |s| s.latch_moment.len());
+    Value::Array(
+        (0..n)
+            .map(|i| {
+                let (m, t) = r
+                    .samples
+                    .iter()
+                    .map(|s| (s.latch_moment[i].abs(), s.t))
+                    .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a });
+                json!({"hinge": i + 1, "moment": m, "time": t})
+            })
+            .collect(),
+    )
+}
+
 /// "flexible, 12 of 40 modes" / "rigid", and the synchronisation's name.
 fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
     let base = match d.base {
@@ -149,7 +170,9 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "synchronisation": model_names(d, c).1,
         "panels": d.chain.len(),
         "latching": latching_name(d.latching),
+        "latch_model": if c.latch.is_some() { "compliant" } else { "rigid" },
         "latches": latches,
+        "captures": r.captures.iter().map(|k| json!({"time": k.time, "hinge": k.hinge, "rates": k.rates})).collect::<Vec<_>>(),
         "all_latched": r.all_latched,
         "final_time": r.final_time,
         "rhs_evaluations": r.evaluations,
@@ -159,6 +182,7 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "hub": hub_json(c, r),
         "peak_root_loads": peak_root_loads(c, r),
         "peak_hinge_reactions": peak_hinge_reactions(r),
+        "peak_latch_moments": peak_latch_moments(r),
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }
@@ -228,6 +252,13 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
             );
         }
     }
+    for k in &r.captures {
+        let _ = writeln!(
+            s,
+            "\ncapture of hinge {} by its compliant latch at t = {:.9} s (rates {:?} rad/s)",
+            k.hinge, k.time, k.rates
+        );
+    }
     let _ = writeln!(
         s,
         "\n{} at t = {:.9} s",
@@ -294,6 +325,10 @@ fn csv_header(c: &Coupled) -> String {
     if c.sync != Synchronisation::None {
         (1..n).for_each(|k| cols(format!("cable_torque_{k} [N·m]")));
     }
+    if c.latch.is_some() {
+        (1..=n).for_each(|i| cols(format!("latch_moment_{i} [N·m]")));
+        cols("latch_energy [J]".to_string());
+    }
     for e in ["kinetic_energy", "spring_energy", "elastic_energy"] {
         cols(format!("{e} [J]"));
     }
@@ -336,6 +371,10 @@ fn deployment_csv(c: &Coupled, r: &DeploymentResult) -> String {
         row.extend(s.force.iter().map(|f| f[1]));
         row.extend(&s.moment);
         row.extend((0..cables).map(|k| b.cable_torque.get(k).copied().unwrap_or(0.0)));
+        if c.latch.is_some() {
+            row.extend(&s.latch_moment);
+            row.push(s.latch_energy);
+        }
         row.extend([s.kinetic, s.spring, b.elastic]);
         row.extend(b.momentum);
         row.extend(b.angular_momentum);

@@ -103,6 +103,8 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             })).collect::<Vec<_>>(),
             "peak_root_loads": super::deploy::peak_root_loads(&sim.coupled, dep),
             "peak_hinge_reactions": super::deploy::peak_hinge_reactions(dep),
+            "captures": dep.captures.iter().map(|k| json!({"time": k.time, "hinge": k.hinge, "rates": k.rates})).collect::<Vec<_>>(),
+            "peak_latch_moments": super::deploy::peak_latch_moments(dep),
         },
         "modes": {
             "dof": sim.modes.dof,

@@ -3,12 +3,15 @@
 //! from the structure by [`crate::deploy::planar`].
 
 use super::context::Ctx;
-use super::raw::{RawBase, RawDeployment, RawIntegrator, RawLatching, RawSynchronisation, S};
+use super::raw::{
+    RawBase, RawDeployment, RawIntegrator, RawLatchModel, RawLatching, RawPerHinge,
+    RawSynchronisation, S,
+};
 use super::ScenarioError;
 use crate::deploy::base::BaseKind;
 use crate::deploy::chain::Hinge;
 use crate::deploy::coupled::Synchronisation;
-use crate::deploy::{Deployment, Integrator, Latching};
+use crate::deploy::{Deployment, Integrator, LatchModel, Latching};
 use crate::limits as L;
 use crate::structure::HubMotion;
 use crate::structure::Structure;
@@ -100,7 +103,9 @@ pub(super) fn lower(
     }
     let (end_time, output_rate, tolerance) = run_settings(cx, raw)?;
     let synchronisation = synchronisation(cx, raw, &chain.hinges)?;
+    let latch = latch(cx, raw, chain.len())?;
     Ok(Deployment {
+        latch,
         integrator: match d.integrator.as_ref().map(|i| *i.get_ref()) {
             Some(RawIntegrator::Implicit) => Integrator::Implicit,
             _ => Integrator::Explicit,
@@ -116,6 +121,78 @@ pub(super) fn lower(
         end_time,
         output_rate,
         tolerance,
+    })
+}
+
+/// `[deployment.latch]`: the rigid latch (default) or the compliant one with its stiffness
+/// and damping (one value or one per hinge) and settle time.
+fn latch(cx: &Ctx, raw: &S<RawDeployment>, n: usize) -> Result<LatchModel, ScenarioError> {
+    let Some(l) = &raw.get_ref().latch else {
+        return Ok(LatchModel::Rigid);
+    };
+    let lr = l.get_ref();
+    let compliant = matches!(
+        lr.model.as_ref().map(|m| *m.get_ref()),
+        Some(RawLatchModel::Compliant)
+    );
+    if !compliant {
+        for (key, span) in [
+            ("stiffness", lr.stiffness.as_ref().map(|v| v.span())),
+            ("damping", lr.damping.as_ref().map(|v| v.span())),
+            ("settle_time", lr.settle_time.as_ref().map(|v| v.span())),
+        ] {
+            if let Some(span) = span {
+                return Err(cx.invalid(
+                    span,
+                    format!("deployment.latch.{key}"),
+                    "a rigid latch (model = \"rigid\", the default) has no stiffness, damping or \
+                     settle time: set model = \"compliant\" or remove the key",
+                ));
+            }
+        }
+        return Ok(LatchModel::Rigid);
+    }
+    let per_hinge = |v: &Option<S<RawPerHinge>>,
+                     key: &str,
+                     limit: L::Limit|
+     -> Result<Vec<f64>, ScenarioError> {
+        let key = format!("deployment.latch.{key}");
+        let Some(v) = v else {
+            return Err(cx.missing(
+                l.span(),
+                key,
+                "missing: a compliant latch needs stiffness and damping",
+            ));
+        };
+        let values = match v.get_ref() {
+            RawPerHinge::One(x) => vec![*x; n],
+            RawPerHinge::Each(list) if list.len() == n => list.clone(),
+            RawPerHinge::Each(list) => {
+                return Err(cx.invalid(
+                    v.span(),
+                    key,
+                    format!(
+                        "{} values for {n} hinges: give one value, or one per hinge",
+                        list.len()
+                    ),
+                ))
+            }
+        };
+        if let Some(bad) = values.iter().find(|x| !limit.contains(**x)) {
+            return Err(cx.invalid(v.span(), key, limit.refusal(*bad)));
+        }
+        Ok(values)
+    };
+    let stiffness = per_hinge(&lr.stiffness, "stiffness", L::LATCH_STIFFNESS)?;
+    let damping = per_hinge(&lr.damping, "damping", L::LATCH_DAMPING)?;
+    let settle_time = match &lr.settle_time {
+        Some(v) => Some(cx.bounded(v, "deployment.latch.settle_time", L::DURATION)?),
+        None => None,
+    };
+    Ok(LatchModel::Compliant {
+        stiffness,
+        damping,
+        settle_time,
     })
 }
 

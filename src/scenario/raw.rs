@@ -179,6 +179,7 @@ pub struct RawDeployment {
     pub synchronisation: Option<S<RawSynchronisation>>,
     pub cable_stiffness: Option<S<f64>>,
     pub integrator: Option<S<RawIntegrator>>,
+    pub latch: Option<S<RawLatch>>,
     pub end_time: Option<S<f64>>,
     pub output_rate: Option<S<f64>>,
     pub tolerance: Option<S<f64>>,
@@ -193,6 +194,30 @@ pub struct RawDeployment {
 pub enum RawBase {
     Flexible,
     Rigid,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLatch {
+    pub model: Option<S<RawLatchModel>>,
+    pub stiffness: Option<S<RawPerHinge>>,
+    pub damping: Option<S<RawPerHinge>>,
+    pub settle_time: Option<S<f64>>,
+}
+
+#[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RawLatchModel {
+    Rigid,
+    Compliant,
+}
+
+/// One value for every hinge, or one per hinge.
+#[derive(Debug, Deserialize, Clone, PartialEq)]
+#[serde(untagged)]
+pub enum RawPerHinge {
+    One(f64),
+    Each(Vec<f64>),
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]

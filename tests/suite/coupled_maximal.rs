@@ -1051,6 +1051,7 @@ fn rigid_mast_limit_agrees_with_the_rigid_chain() {
         base: flexcraft::deploy::base::BaseKind::Rigid,
         synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
         integrator: flexcraft::deploy::Integrator::Explicit,
+        latch: flexcraft::deploy::LatchModel::Rigid,
         tolerance: 1e-12,
     });
     assert_eq!(

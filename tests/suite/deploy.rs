@@ -51,6 +51,7 @@ pub fn deployment(chain: Chain, latching: Latching, tol: f64) -> Deployment {
         base: flexcraft::deploy::base::BaseKind::Rigid,
         synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
         integrator: flexcraft::deploy::Integrator::Explicit,
+        latch: flexcraft::deploy::LatchModel::Rigid,
         tolerance: tol,
     }
 }
