@@ -479,7 +479,19 @@ pub fn hand_over_coupled(
     result: &DeploymentResult,
     method: HandoverMethod,
 ) -> Result<Handover, ResponseError> {
-    let last = final_latch(result)?;
+    // Rigid latches end the run at the final latch; compliant ones after the settling that
+    // follows the last capture: the hand-over is at the run's end either way.
+    if !result.all_latched {
+        return Err(ResponseError::NotLatched {
+            hinges: result.unlatched.iter().map(|u| u.0).collect(),
+            time: result.final_time,
+        });
+    }
+    let last = result.latches.last();
+    let last_hinge = last
+        .map(|e| e.hinge)
+        .or_else(|| result.captures.last().map(|c| c.hinge))
+        .unwrap_or(0);
     let view = PlateView::find(model, &deployment.plate)?;
     let n = model.dof();
     let y: Vec<f64> = result
@@ -523,7 +535,17 @@ pub fn hand_over_coupled(
     let energy_before = coupled.kinetic_energy(&y);
     let (b, energy_before_field) = match method {
         HandoverMethod::Projection => projected_impulse(model, &view, &pl, &mut notes),
-        HandoverMethod::Impulse => (latch_impulse(model, &view, &pl, last), energy_before),
+        HandoverMethod::Impulse => match last {
+            Some(last) => (latch_impulse(model, &view, &pl, last), energy_before),
+            None => {
+                notes.push(
+                    "the impulse hand-over applies the final latch's impulses; compliant latches \
+                     have none, so nothing is applied"
+                        .to_string(),
+                );
+                (vec![0.0; n], energy_before)
+            }
+        },
     };
     let (linear, angular) = coupled.momentum_hub(&y);
     // Rows 0..6 of b = M q̇⁺ are the linear model's momentum. The projection gives the
@@ -574,8 +596,8 @@ pub fn hand_over_coupled(
     }
     Ok(Handover {
         method,
-        latch_time: last.time,
-        latch_hinge: last.hinge,
+        latch_time: result.final_time,
+        latch_hinge: last_hinge,
         generalized_impulse: b,
         modal_velocity: eta_dot,
         qdot,

@@ -496,3 +496,63 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
         .iter()
         .any(|w| w.to_string().contains("base_modes = 500 is outside")));
 }
+
+/// `[deployment.latch]` (issue 19): each bad value is refused with its line, key and
+/// reason, exit 2, nothing written.
+#[test]
+fn latch_keys_are_refused_with_location() {
+    let dir = scratch("latch-keys");
+    let with = |latch: &str| {
+        SEED.replace(
+            "[deployment.hinge]",
+            &format!("{latch}\n[deployment.hinge]"),
+        )
+    };
+    let cases = [
+        (
+            with("[deployment.latch]\nmodel = \"compliant\"\nstiffness = 0.0\ndamping = 10.0"),
+            "stiffness = 0.0",
+            "deployment.latch.stiffness",
+            "positive",
+        ),
+        (
+            with("[deployment.latch]\nmodel = \"compliant\"\nstiffness = 1e5\ndamping = -1.0"),
+            "damping = -1.0",
+            "deployment.latch.damping",
+            "[0, 1e9]",
+        ),
+        (
+            with(
+                "[deployment.latch]\nmodel = \"compliant\"\nstiffness = [1e5, 1e5]\ndamping = 10.0",
+            ),
+            "stiffness = [1e5, 1e5]",
+            "deployment.latch.stiffness",
+            "2 values for 3 hinges",
+        ),
+        (
+            with("[deployment.latch]\nmodel = \"rigid\"\ndamping = 10.0"),
+            "damping = 10.0",
+            "deployment.latch.damping",
+            "rigid latch",
+        ),
+        (
+            with("[deployment.latch]\nsettle_time = 2.0"),
+            "settle_time = 2.0",
+            "deployment.latch.settle_time",
+            "rigid latch",
+        ),
+        (
+            with("[deployment.latch]\nmodel = \"springy\""),
+            "model = \"springy\"",
+            "deployment.latch.model",
+            "springy",
+        ),
+    ];
+    for (k, (src, needle, key, reason)) in cases.iter().enumerate() {
+        assert_ne!(src, SEED, "case {k}");
+        let sub = dir.join(format!("case{k}"));
+        std::fs::create_dir_all(&sub).unwrap();
+        let out = run(&sub, "deploy", src, &[]);
+        assert_refused(&sub, &out, line_of(src, needle), key, reason);
+    }
+}
