@@ -462,6 +462,40 @@ fn base_state(coupled: &Coupled, model: &RitzModel, y: &[f64]) -> (Vec<f64>, Vec
     (velocity, q0)
 }
 
+/// The coupled state as the hand-over's pre-latch motion: the hub's velocity, the base's
+/// elastic velocity (deployed model's coordinates) and every panel's rigid motion.
+fn coupled_pre_latch(coupled: &Coupled, y: &[f64], ea: Vec3, base_velocity: Vec<f64>) -> PreLatch {
+    let sv = coupled.view(y);
+    let ev = coupled.evaluate(y);
+    let mut start = 0.0;
+    let panels = coupled
+        .panel_motion(y, &ev)
+        .into_iter()
+        .zip(&coupled.chain.panels)
+        .map(|((_, v, w), p)| {
+            let pm = PanelMotion {
+                start,
+                length: p.length,
+                mass: p.mass,
+                inertia: p.inertia,
+                v_centre: v,
+                v_per_metre: w.cross(ea),
+                omega: w,
+            };
+            start += p.length;
+            pm
+        })
+        .collect();
+    PreLatch {
+        v_hub: sv.v,
+        w_hub: sv.w,
+        base_velocity,
+        panels,
+        theta: 0.0,
+        hub_state: [0.0; 3],
+    }
+}
+
 /// Hands the coupled model's state after the final latch ([`crate::deploy::coupled`]) over
 /// to the deployed structure's Ritz model: the base's rigid and elastic velocity and its
 /// elastic displacement map one to one onto the deployed model's coordinates (the base's
@@ -500,37 +534,8 @@ pub fn hand_over_coupled(
         .chain(&result.final_qd)
         .copied()
         .collect();
-    let sv = coupled.view(&y);
     let (base_velocity, q0) = base_state(coupled, model, &y);
-    let ev = coupled.evaluate(&y);
-    let ea = view.plate.length_axis;
-    let mut start = 0.0;
-    let panels = coupled
-        .panel_motion(&y, &ev)
-        .into_iter()
-        .zip(&coupled.chain.panels)
-        .map(|((_, v, w), p)| {
-            let pm = PanelMotion {
-                start,
-                length: p.length,
-                mass: p.mass,
-                inertia: p.inertia,
-                v_centre: v,
-                v_per_metre: w.cross(ea),
-                omega: w,
-            };
-            start += p.length;
-            pm
-        })
-        .collect();
-    let pl = PreLatch {
-        v_hub: sv.v,
-        w_hub: sv.w,
-        base_velocity,
-        panels,
-        theta: 0.0,
-        hub_state: [0.0; 3],
-    };
+    let pl = coupled_pre_latch(coupled, &y, view.plate.length_axis, base_velocity);
     let mut notes = Vec::new();
     let energy_before = coupled.kinetic_energy(&y);
     let (b, energy_before_field) = match method {
