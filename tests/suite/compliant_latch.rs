@@ -138,3 +138,171 @@ fn stiffer_latches_tend_to_the_plastic_impact() {
         last = off;
     }
 }
+
+/// The planar case of tests/suite/coupled.rs (free 1500 kg hub, 8 m elastic mast, three
+/// panels) with compliant latches.
+const MAST_CASE: &str = r#"
+name = "mast and three panels, compliant latches"
+[hub]
+motion = "free"
+mass = 1500.0
+inertia = [1267.5, 1267.5, 1267.5]
+center_of_mass = [0.0, 0.0, 0.0]
+[materials.aluminium]
+youngs_modulus = 70e9
+poisson_ratio = 0.3
+density = 2700.0
+[[beams]]
+name = "mast"
+parent = "hub"
+root = [1.3, 0.0, 0.0]
+axis = [1.0, 0.0, 0.0]
+length = 8.0
+material = "aluminium"
+section = { tube = { outer_diameter = 0.2, wall = 0.005 } }
+terms = { bending = 4, torsion = 2, axial = 2 }
+[[plates]]
+name = "wing"
+parent = "mast"
+station = 8.0
+length_axis = [0.0, -1.0, 0.0]
+normal = [1.0, 0.0, 0.0]
+length = 6.0
+width = 1.0
+areal_density = 10.0
+bending_stiffness = 1.0e4
+poisson_ratio = 0.3
+terms = { length = 4, width = 2 }
+[deployment]
+plate = "wing"
+panels = 3
+base_modes = 3
+end_time = 12.0
+output_rate = 8000.0
+tolerance = 1e-12
+[deployment.hinge]
+stiffness = 2.0
+preload_angle = 0.5
+[deployment.latch]
+model = "compliant"
+stiffness = 2.0e3
+damping = 20.0
+settle_time = 1.0
+"#;
+
+/// Free hub, elastic mast, compliant latches, no hinge damping: kinetic + hinge springs +
+/// elastic + latch springs + dissipated (∫ Σ c_L α̇_j² dt over the captured hinges, Simpson
+/// on 0.125 ms samples, piecewise between captures) equals the initial energy to 1e-9 of it; the linear momentum and the
+/// angular momentum about the system's centre of mass stay zero (the system starts at rest)
+/// to 1e-9 of the largest panel momentum, from release through every capture.
+#[test]
+fn compliant_latches_conserve_energy_with_dissipation_and_momentum() {
+    let sc = Scenario::from_toml_str(MAST_CASE, "mast.toml").unwrap();
+    let d = sc.deployment.as_ref().unwrap();
+    let (c, r) = simulate_coupled(&sc.structure, d).unwrap();
+    assert!(!r.captures.is_empty(), "no capture by t = {}", r.final_time);
+    let damping = &c.latch.as_ref().unwrap().damping;
+    let capture_time = |j: usize| {
+        r.captures
+            .iter()
+            .find(|k| k.hinge == j + 1)
+            .map_or(f64::INFINITY, |k| k.time)
+    };
+    let h = 1.0 / d.output_rate;
+    let energy = |s: &flexcraft::deploy::Sample| {
+        s.kinetic + s.spring + s.latch_energy + s.body.as_ref().unwrap().elastic
+    };
+    let e0 = energy(&r.samples[0]);
+    // ∫ power dt, piece by piece between captures (the damper's power jumps at a capture):
+    // each piece starts at the capture's own sample, then runs on the uniform grid; the
+    // first, uneven interval and a last odd one by the quadratic through three samples
+    // (3-point Gauss on it), the rest by Simpson.
+    let mut bounds: Vec<f64> = r.captures.iter().map(|k| k.time).collect();
+    bounds.dedup();
+    bounds.push(r.final_time);
+    let mut dissipated = 0.0;
+    let mut t0 = bounds[0];
+    for w in bounds.windows(2) {
+        // Within the piece the captured set is that of its start.
+        let pw = |s: &flexcraft::deploy::Sample| -> f64 {
+            (0..c.panels())
+                .filter(|&j| capture_time(j) <= w[0])
+                .map(|j| damping[j] * s.rate[j] * s.rate[j])
+                .sum()
+        };
+        let on_grid = |t: f64| ((t / h).round() * h - t).abs() < 1e-9;
+        let mut pts: Vec<_> = r
+            .samples
+            .iter()
+            .filter(|s| s.t >= w[0] && s.t <= w[1])
+            .filter(|s| s.t == w[0] || s.t == w[1] || on_grid(s.t))
+            .collect();
+        pts.dedup_by(|a, b| a.t == b.t);
+        let n = pts.len();
+        assert!(n > 6 && pts[0].t == w[0], "piece from {}", w[0]);
+        let quad = |k: usize, a: f64, b: f64| {
+            let (x, f): (Vec<f64>, Vec<f64>) = (k..k + 3).map(|i| (pts[i].t, pw(pts[i]))).unzip();
+            let lagrange = |t: f64| {
+                (0..3)
+                    .map(|i| {
+                        f[i] * (0..3)
+                            .filter(|&j| j != i)
+                            .map(|j| (t - x[j]) / (x[i] - x[j]))
+                            .product::<f64>()
+                    })
+                    .sum::<f64>()
+            };
+            let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+            let g = (0.6_f64).sqrt();
+            half * (5.0 * lagrange(mid - g * half)
+                + 8.0 * lagrange(mid)
+                + 5.0 * lagrange(mid + g * half))
+                / 9.0
+        };
+        // The uneven first interval, Simpson pairs on the grid, then what is left (the
+        // uneven last interval to the next capture among it) interval by interval.
+        dissipated += quad(0, pts[0].t, pts[1].t);
+        let last_grid = if on_grid(pts[n - 1].t) { n - 1 } else { n - 2 };
+        let mut k = 1;
+        while k + 2 <= last_grid {
+            let (a, b, c2) = (pts[k], pts[k + 1], pts[k + 2]);
+            dissipated += (c2.t - a.t) / 6.0 * (pw(a) + 4.0 * pw(b) + pw(c2));
+            k += 2;
+        }
+        while k + 1 < n {
+            dissipated += quad(n - 3, pts[k].t, pts[k + 1].t);
+            k += 1;
+        }
+        let e = energy(pts[n - 1]);
+        assert!(
+            (e0 - e - dissipated).abs() < 1e-9 * e0,
+            "t = {} (piece from {}): E0 − E = {} vs dissipated {dissipated}",
+            pts[n - 1].t,
+            w[0],
+            e0 - e
+        );
+        t0 = pts[n - 1].t;
+    }
+    assert!(t0 > r.captures.last().unwrap().time);
+    assert!(
+        dissipated > 1e-3 * e0,
+        "the latches dissipate: {dissipated} of {e0}"
+    );
+    let scale = c
+        .chain
+        .panels
+        .iter()
+        .map(|p| p.mass * p.length)
+        .fold(0.0, f64::max)
+        * r.captures[0]
+            .rates
+            .iter()
+            .fold(0.0_f64, |a, x| a.max(x.abs()));
+    for s in &r.samples {
+        let b = s.body.as_ref().unwrap();
+        let p = b.momentum.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let l = b.angular_momentum.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!(p < 1e-9 * scale, "t = {}: linear momentum {p}", s.t);
+        assert!(l < 1e-8 * scale * 10.0, "t = {}: angular momentum {l}", s.t);
+    }
+}
