@@ -64,6 +64,9 @@ pub enum Warning {
         /// The base's hub-fixed modes.
         available: usize,
     },
+    /// Rigid latches on an elastic base: the latch outcome with half of the kept base modes
+    /// (the latch with the largest change of the base impulse).
+    RigidLatchTruncation(crate::deploy::HalfModes),
     /// The array locked away from the straight wing; the hand-over uses the straight wing.
     AngleMismatch {
         /// Largest hinge-angle mismatch, rad.
@@ -155,6 +158,19 @@ impl fmt::Display for Warning {
                 } else {
                     ""
                 }
+            ),
+            Self::RigidLatchTruncation(h) => write!(
+                f,
+                "rigid latch on an elastic base: the base impulse changes {:.1} % (force) and \
+                 {:.1} % (moment), the rates after the latch {:.1} %, between {} and {} base \
+                 modes: its loads depend on the truncation (a rigid latch on an elastic base has \
+                 no continuum limit); use [deployment.latch] model = \"compliant\" for \
+                 latch-up loads",
+                100.0 * h.force_change,
+                100.0 * h.moment_change,
+                100.0 * h.rates_change,
+                h.modes,
+                h.kept
             ),
             Self::AngleMismatch { rad } => write!(
                 f,

@@ -240,6 +240,25 @@ pub struct LatchEvent {
     /// The coupled model: the impulse the base receives at the root hinge, hub components:
     /// force (N·s) and moment about the hinge point (N·m·s).
     pub base_impulse: Option<([f64; 3], [f64; 3])>,
+    /// A rigid latch on an elastic base: the same impact computed with half of the kept base
+    /// modes, and how much its outcome changes.
+    pub half_modes: Option<HalfModes>,
+}
+
+/// A rigid latch's sensitivity to the base's truncation (MODEL.md §3.2: a rigid latch on an
+/// elastic base has no continuum limit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfModes {
+    /// Base modes of the comparison (half of those kept).
+    pub modes: usize,
+    /// Base modes kept in the run.
+    pub kept: usize,
+    /// |ΔF| / |F| of the base impulse's force between the two.
+    pub force_change: f64,
+    /// |ΔM| / |M| of the base impulse's moment.
+    pub moment_change: f64,
+    /// |Δα̇⁺| / |α̇⁺| of the hinge rates after the impact (|Δα̇⁺| when α̇⁺ = 0).
+    pub rates_change: f64,
 }
 
 /// How a deployment run ended.
@@ -333,6 +352,7 @@ pub fn simulate_coupled(
 ) -> Result<(Coupled, DeploymentResult), DeployError> {
     let c = d.coupled(st)?;
     let mut r = run::run(&c, &d.settings(), MAX_STEPS);
+    truncation_check(st, d, &c, &mut r)?;
     if let BaseKind::Flexible {
         modes: Some(requested),
     } = d.base
@@ -350,6 +370,80 @@ pub fn simulate_coupled(
         }
     }
     Ok((c, r))
+}
+
+/// Rigid latches on an elastic base: every latch's impact again with half of the kept base
+/// modes (the first half of the same modes), its relative change recorded in the event and
+/// the largest stated in a warning.
+fn truncation_check(
+    st: &Structure,
+    d: &Deployment,
+    c: &Coupled,
+    r: &mut DeploymentResult,
+) -> Result<(), DeployError> {
+    let m = c.modes();
+    if d.latch != LatchModel::Rigid || m < 2 || r.latches.is_empty() {
+        return Ok(());
+    }
+    let half = Deployment {
+        base: BaseKind::Flexible { modes: Some(m / 2) },
+        ..d.clone()
+    }
+    .coupled(st)?;
+    let nh = half.positions();
+    let (e0, h0) = (c.alpha_offset() - m, m / 2); // η's start and the half count
+    let n = c.panels();
+    let mut free = vec![true; n];
+    let mut worst: Option<HalfModes> = None;
+    for e in &mut r.latches {
+        let mut free_after = free.clone();
+        for &j in &e.locked {
+            free_after[j - 1] = false;
+        }
+        // The state with the upper half of η and η̇ dropped.
+        let mut y = Vec::with_capacity(nh + half.speeds());
+        y.extend_from_slice(&e.q[..e0 + h0]);
+        y.extend_from_slice(&e.q[e0 + m..]);
+        let s0 = c.hub_dof();
+        y.extend_from_slice(&e.qd_before[..s0 + h0]);
+        y.extend_from_slice(&e.qd_before[s0 + m..]);
+        let (u, imp) = run::Engine::impact(&half, &y, &free_after);
+        let rel = |a: &[f64], b: &[f64]| {
+            let d: f64 = a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let s: f64 = b.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if s > 0.0 {
+                d / s
+            } else {
+                d
+            }
+        };
+        let ((f, mo), (fh, mh)) = (
+            e.base_impulse.unwrap_or_default(),
+            imp.base.unwrap_or_default(),
+        );
+        let ro = half.rate_offset();
+        let check = HalfModes {
+            modes: m / 2,
+            kept: m,
+            force_change: rel(&fh, &f),
+            moment_change: rel(&mh, &mo),
+            rates_change: rel(&u[ro..ro + n], &e.rates_after),
+        };
+        e.half_modes = Some(check);
+        if worst.is_none_or(|w| check.force_change > w.force_change) {
+            worst = Some(check);
+        }
+        free = free_after;
+    }
+    if let Some(w) = worst {
+        r.warnings.push(Warning::RigidLatchTruncation(w));
+    }
+    Ok(())
 }
 
 impl Deployment {

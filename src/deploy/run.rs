@@ -411,6 +411,7 @@ impl<'a, E: Engine> Run<'a, E> {
             qd_before,
             qd_after: u_new,
             base_impulse: impulses.base,
+            half_modes: None,
         };
         self.latches.push(event);
         self.sys.free = free_after;

@@ -154,6 +154,12 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
                     "hinge": i + 1, "force": f, "moment": m,
                 })).collect::<Vec<_>>(),
                 "base_impulse": e.base_impulse.map(|(f, m)| json!({"force": f, "moment": m})),
+                "half_base_modes": e.half_modes.map(|h| json!({
+                    "modes": h.modes, "kept": h.kept,
+                    "base_impulse_force_change": h.force_change,
+                    "base_impulse_moment_change": h.moment_change,
+                    "rates_after_change": h.rates_change,
+                })),
             })
         })
         .collect();
