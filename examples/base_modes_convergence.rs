@@ -120,7 +120,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             BaseKind::Flexible { modes: Some(modes) }
         };
         let (_, r) = simulate_coupled(&sc.structure, &d)?;
-        let times: Vec<String> = r.captures.iter().map(|k| format!("{:.9}", k.time)).collect();
+        let times: Vec<String> = r
+            .captures
+            .iter()
+            .map(|k| format!("{:.9}", k.time))
+            .collect();
         let peaks: Vec<String> = (0..3)
             .map(|j| {
                 let p = r
@@ -143,7 +147,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         println!(
             "{} | {} | {} | {:.4} at {:.3}",
-            if modes == 0 { "rigid".to_string() } else { modes.to_string() },
+            if modes == 0 {
+                "rigid".to_string()
+            } else {
+                modes.to_string()
+            },
             times.join(", "),
             peaks.join(", "),
             peak,
