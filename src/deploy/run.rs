@@ -320,7 +320,10 @@ impl<'a, E: Engine> Run<'a, E> {
         step.eval(e.t, &mut self.y);
         self.t = e.t;
         let open = self.sys.open();
-        let all = engine.ideal_cable() || self.s.latching == Latching::Simultaneous;
+        // A compliant latch captures its hinge when the hinge reaches it; "simultaneous"
+        // latching does not apply (it would pull bent hinges onto their latch angles), and
+        // an ideal cable brings every hinge to its latch at once.
+        let all = engine.ideal_cable();
         for j in 0..self.latch_angles.len() {
             if open[j] && (all || j == e.hinge) {
                 self.sys.captured[j] = true;
