@@ -88,6 +88,42 @@ pub struct PlanarCase {
     pub initial_angle: Vec<f64>,
     /// s.
     pub end_time: f64,
+    /// A compliant latch instead of the rigid one (`None`: the plastic impact).
+    pub compliant: Option<CompliantLatch>,
+}
+
+/// The compliant latch: once α_j first reaches α_j^L while opening, the hinge moment gains
+/// −k_L,j (α_j − α_j^L) − c_L,j α̇_j for good (the hinge spring keeps acting); no velocity jump.
+#[derive(Debug, Clone)]
+pub struct CompliantLatch {
+    /// k_L per hinge, N·m/rad.
+    pub stiffness: Vec<f64>,
+    /// c_L per hinge, N·m·s/rad.
+    pub damping: Vec<f64>,
+    /// How long the run continues after the last capture, s.
+    pub settle_time: f64,
+}
+
+/// One capture by a compliant latch.
+#[derive(Debug, Clone)]
+pub struct PlanarCapture {
+    /// 1-based hinge number.
+    pub hinge: usize,
+    /// s.
+    pub time: f64,
+    /// dα_i/dt at the capture.
+    pub rates: Vec<f64>,
+}
+
+/// The state at a requested output time.
+#[derive(Debug, Clone)]
+pub struct PlanarSample {
+    /// s.
+    pub t: f64,
+    /// α_i, rad.
+    pub alpha: Vec<f64>,
+    /// The compliant latches' moments, N·m (zero before capture).
+    pub latch_moment: Vec<f64>,
 }
 
 /// One latch.
@@ -116,6 +152,10 @@ pub struct PlanarResult {
     pub tip_at_end: [f64; 2],
     /// X, Y, θ at final_time.
     pub hub_at_end: [f64; 3],
+    /// Compliant latches: captures in time order.
+    pub captures: Vec<PlanarCapture>,
+    /// The states at the requested output times (see [`solve_planar_sampled`]).
+    pub samples: Vec<PlanarSample>,
 }
 
 /// Diagnostics of one run (for the conservation tests).
@@ -136,13 +176,21 @@ pub struct Diagnostics {
 pub fn solve_planar(case: &PlanarCase) -> PlanarResult {
     let model = Model::new(case);
     let h = model.default_step();
-    model.run(h, None)
+    model.run(h, None, &[])
+}
+
+/// Runs the case with the step `h` and returns the state at each of `times` (ascending),
+/// each taken by a Gauss step of its own from the last step point before it (the main
+/// trajectory is not changed by the sampling).
+#[allow(dead_code)]
+pub fn solve_planar_sampled(case: &PlanarCase, h: f64, times: &[f64]) -> PlanarResult {
+    Model::new(case).run(h, None, times)
 }
 
 /// Runs the case with the step `h` (for convergence checks of a comparison).
 #[allow(dead_code)]
 pub fn solve_planar_with_step(case: &PlanarCase, h: f64) -> PlanarResult {
-    Model::new(case).run(h, None)
+    Model::new(case).run(h, None, &[])
 }
 
 /// Runs the case with the step `h`, recording energy and momenta.
@@ -153,7 +201,7 @@ pub fn solve_planar_diagnostics(case: &PlanarCase, h: f64) -> (PlanarResult, Dia
         max_panel_momentum: 0.0,
         max_violation: 0.0,
     };
-    let r = Model::new(case).run(h, Some(&mut d));
+    let r = Model::new(case).run(h, Some(&mut d), &[]);
     (r, d)
 }
 
@@ -267,6 +315,8 @@ struct Model<'a> {
     k: Vec<f64>,
     rigid_axial: bool,
     rigid_bending: bool,
+    /// The hinges a compliant latch has captured.
+    captured: std::cell::RefCell<Vec<bool>>,
     /// The last Gauss step: end state, step and stage accelerations (the next predictor).
     #[allow(clippy::type_complexity)]
     last: std::cell::RefCell<Option<(Vec<f64>, Vec<f64>, f64, [Vec<f64>; 3])>>,
@@ -335,6 +385,7 @@ impl<'a> Model<'a> {
             k,
             rigid_axial,
             rigid_bending,
+            captured: std::cell::RefCell::new(vec![false; n]),
             last: std::cell::RefCell::new(None),
         }
     }
@@ -410,6 +461,17 @@ impl<'a> Model<'a> {
             PI / 2.0 + self.case.psi0 + lin
         } else {
             PI + lin
+        }
+    }
+
+    /// −k_L (α − α^L) − c_L α̇ on a captured hinge, zero otherwise.
+    fn latch_moment(&self, q: &[f64], v: &[f64], i0: usize) -> f64 {
+        match &self.case.compliant {
+            Some(l) if self.captured.borrow()[i0] => {
+                -l.stiffness[i0] * (self.alpha(q, i0) - self.case.latch_angle[i0])
+                    - l.damping[i0] * self.rate(v, i0)
+            }
+            _ => 0.0,
         }
     }
 
@@ -597,7 +659,8 @@ impl<'a> Model<'a> {
         let mut f = vec![0.0; self.ndof];
         f[..self.nbase].copy_from_slice(&fb);
         for i0 in 0..self.n {
-            let tau = self.case.stiffness[i0] * (self.case.reference_angle[i0] - self.alpha(q, i0));
+            let tau = self.case.stiffness[i0] * (self.case.reference_angle[i0] - self.alpha(q, i0))
+                + self.latch_moment(q, v, i0);
             for (j, cf) in self.alpha_grad(i0) {
                 f[j] += tau * cf;
             }
@@ -849,7 +912,7 @@ impl<'a> Model<'a> {
         (q, vec![0.0; self.ndof])
     }
 
-    fn run(&self, h: f64, mut diag: Option<&mut Diagnostics>) -> PlanarResult {
+    fn run(&self, h: f64, mut diag: Option<&mut Diagnostics>, times: &[f64]) -> PlanarResult {
         let c = self.case;
         let n = self.n;
         let mut locked = vec![false; n];
@@ -875,29 +938,68 @@ impl<'a> Model<'a> {
             }
         };
         record(&mut diag, t, &q, &v);
+        let compliant = c.compliant.is_some();
+        self.captured
+            .borrow_mut()
+            .iter_mut()
+            .for_each(|x| *x = false);
+        let mut captures: Vec<PlanarCapture> = Vec::new();
+        let mut samples: Vec<PlanarSample> = Vec::new();
+        let mut next_sample = 0;
+        // The states at the output times in (t, t_end], by Gauss steps of their own from (q, v).
+        let mut sample_to = |t: f64, t_end: f64, q: &[f64], v: &[f64], locked: &[bool]| {
+            while next_sample < times.len() && times[next_sample] <= t_end {
+                let ts = times[next_sample];
+                next_sample += 1;
+                if ts < t {
+                    continue;
+                }
+                let (qs, vs) = if ts > t {
+                    self.step(q, v, ts - t, locked)
+                } else {
+                    (q.to_vec(), v.to_vec())
+                };
+                samples.push(PlanarSample {
+                    t: ts,
+                    alpha: (0..n).map(|i| self.alpha(&qs, i)).collect(),
+                    latch_moment: (0..n).map(|i| self.latch_moment(&qs, &vs, i)).collect(),
+                });
+            }
+        };
         let crossed = |q: &[f64], locked: &[bool]| -> Option<usize> {
+            let captured = self.captured.borrow();
             (0..n)
-                .filter(|&i| !locked[i] && self.alpha(q, i) >= c.latch_angle[i])
+                .filter(|&i| !locked[i] && !captured[i] && self.alpha(q, i) >= c.latch_angle[i])
                 .max_by(|&i, &j| {
                     (self.alpha(q, i) - c.latch_angle[i])
                         .total_cmp(&(self.alpha(q, j) - c.latch_angle[j]))
                 })
         };
-        while t < c.end_time && locked.iter().any(|l| !l) {
-            let step = h.min(c.end_time - t);
+        let open = |locked: &[bool]| {
+            let captured = self.captured.borrow();
+            (0..n).any(|i| !locked[i] && !captured[i])
+        };
+        // The run's end: end_time, or settle_time after the last capture once all are captured.
+        let stop = |locked: &[bool], captures: &[PlanarCapture]| -> f64 {
+            match (&c.compliant, captures.last()) {
+                (Some(l), Some(k)) if !open(locked) => (k.time + l.settle_time).min(c.end_time),
+                _ => c.end_time,
+            }
+        };
+        while t < stop(&locked, &captures) && (open(&locked) || compliant) {
+            let t_stop = stop(&locked, &captures);
+            let step = h.min(t_stop - t);
             let (qn, vn) = self.step(&q, &v, step, &locked);
             if crossed(&qn, &locked).is_none() {
+                let t_new = if step == t_stop - t { t_stop } else { t + step };
+                sample_to(t, t_new, &q, &v, &locked);
                 q = qn;
                 v = vn;
-                t = if step == c.end_time - t {
-                    c.end_time
-                } else {
-                    t + step
-                };
+                t = t_new;
                 record(&mut diag, t, &q, &v);
                 continue;
             }
-            // Bisect the sub-step τ at which the first unlatched α_j reaches α_j^L.
+            // Bisect the sub-step τ at which the first open α_j reaches α_j^L.
             let (mut lo, mut hi) = (0.0, step);
             for _ in 0..200 {
                 let mid = 0.5 * (lo + hi);
@@ -913,7 +1015,21 @@ impl<'a> Model<'a> {
             }
             let (qe, ve) = self.step(&q, &v, hi, &locked);
             let j = crossed(&qe, &locked).expect("the crossing persists at the bracket's end");
+            sample_to(t, t + hi, &q, &v, &locked);
             t += hi;
+            if compliant {
+                // Capture: no jump; the integration restarts here with the latch acting.
+                self.captured.borrow_mut()[j] = true;
+                captures.push(PlanarCapture {
+                    hinge: j + 1,
+                    time: t,
+                    rates: (0..n).map(|i| self.rate(&ve, i)).collect(),
+                });
+                q = qe;
+                v = ve;
+                record(&mut diag, t, &q, &v);
+                continue;
+            }
             let rates_before: Vec<f64> = (0..n).map(|i| self.rate(&ve, i)).collect();
             let tip_before = self.tip(&qe);
             let e_before = self.energy(&qe, &ve);
@@ -950,6 +1066,8 @@ impl<'a> Model<'a> {
             final_time: t,
             tip_at_end: self.tip(&q),
             hub_at_end: [q[0], q[1], q[2]],
+            captures,
+            samples,
         }
     }
 }
@@ -979,6 +1097,7 @@ pub fn reference_case() -> PlanarCase {
         latch_angle: latch,
         initial_angle: vec![0.0; 3],
         end_time: 60.0,
+        compliant: None,
     }
 }
 
