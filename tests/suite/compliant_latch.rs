@@ -139,56 +139,34 @@ fn stiffer_latches_tend_to_the_plastic_impact() {
     }
 }
 
-/// The planar case of tests/suite/coupled.rs (free 1500 kg hub, 8 m elastic mast, three
-/// panels) with compliant latches.
-const MAST_CASE: &str = r#"
-name = "mast and three panels, compliant latches"
-[hub]
-motion = "free"
-mass = 1500.0
-inertia = [1267.5, 1267.5, 1267.5]
-center_of_mass = [0.0, 0.0, 0.0]
-[materials.aluminium]
-youngs_modulus = 70e9
-poisson_ratio = 0.3
-density = 2700.0
-[[beams]]
-name = "mast"
-parent = "hub"
-root = [1.3, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length = 8.0
-material = "aluminium"
-section = { tube = { outer_diameter = 0.2, wall = 0.005 } }
-terms = { bending = 4, torsion = 2, axial = 2 }
-[[plates]]
-name = "wing"
-parent = "mast"
-station = 8.0
-length_axis = [0.0, -1.0, 0.0]
-normal = [1.0, 0.0, 0.0]
-length = 6.0
-width = 1.0
-areal_density = 10.0
-bending_stiffness = 1.0e4
-poisson_ratio = 0.3
-terms = { length = 4, width = 2 }
-[deployment]
-plate = "wing"
-panels = 3
-base_modes = 3
-end_time = 12.0
-output_rate = 8000.0
-tolerance = 1e-12
-[deployment.hinge]
-stiffness = 2.0
-preload_angle = 0.5
-[deployment.latch]
-model = "compliant"
-stiffness = 2.0e3
-damping = 20.0
-settle_time = 1.0
-"#;
+/// `super::coupled::PLANAR_CASE` (free 1500 kg hub, 8 m elastic aluminium mast, three 2 m
+/// panels) with its mast function space reduced to bending 4, axial 2 (short runs), the run
+/// settings replaced and compliant latches k_L, c_L added; `extra` goes into `[deployment]`.
+fn planar_compliant(extra: &str, end: f64, rate: f64, kl: f64, cl: f64) -> String {
+    let mut src = super::coupled::PLANAR_CASE.to_string();
+    for (from, to) in [
+        (
+            "terms = { bending = 6, torsion = 2, axial = 4 }",
+            "terms = { bending = 4, torsion = 2, axial = 2 }".to_string(),
+        ),
+        (
+            "end_time = 6.0\noutput_rate = 10.0",
+            format!("{extra}end_time = {end:?}\noutput_rate = {rate:?}"),
+        ),
+    ] {
+        assert!(src.contains(from), "PLANAR_CASE has no {from:?}");
+        src = src.replace(from, &to);
+    }
+    src + &format!(
+        "[deployment.latch]\nmodel = \"compliant\"\nstiffness = {kl:?}\ndamping = {cl:?}\nsettle_time = 1.0\n"
+    )
+}
+
+/// The mast case with three base modes and latches k_L = 2e3 N·m/rad, c_L = 20 N·m·s/rad,
+/// sampled at 8 kHz for 12 s.
+fn mast_case() -> String {
+    planar_compliant("base_modes = 3\n", 12.0, 8000.0, 2.0e3, 20.0)
+}
 
 /// Free hub, elastic mast, compliant latches, no hinge damping: kinetic + hinge springs +
 /// elastic + latch springs + dissipated (∫ Σ c_L α̇_j² dt over the captured hinges, Simpson
@@ -197,7 +175,7 @@ settle_time = 1.0
 /// to 1e-9 of the largest panel momentum, from release through every capture.
 #[test]
 fn compliant_latches_conserve_energy_with_dissipation_and_momentum() {
-    let sc = Scenario::from_toml_str(MAST_CASE, "mast.toml").unwrap();
+    let sc = Scenario::from_toml_str(&mast_case(), "mast.toml").unwrap();
     let d = sc.deployment.as_ref().unwrap();
     let (c, r) = simulate_coupled(&sc.structure, d).unwrap();
     assert!(!r.captures.is_empty(), "no capture by t = {}", r.final_time);
@@ -367,58 +345,11 @@ fn stiff_compliant_latches_tend_to_the_plastic_impact_on_a_rigid_base() {
     assert!(errors[3].1 < 0.02 * rates_r.iter().fold(0.0_f64, |a, x| a.max(x.abs())));
 }
 
-/// The planar case of tests/suite/coupled.rs (`PLANAR_CASE`: free 1500 kg hub, 8 m elastic
-/// aluminium mast, three 2 m panels folding in the x–y plane), with a smaller mast function
-/// space (bending 4, axial 2: the run stays short) and compliant latches k_L = 1e4 N·m/rad,
-/// c_L = 200 N·m·s/rad, sampled at 1 kHz.
-const PLANAR_COMPLIANT: &str = r#"
-name = "planar case of the second formulation, compliant latches"
-format_version = 1
-[hub]
-motion = "free"
-mass = 1500.0
-inertia = [1267.5, 1267.5, 1267.5]
-center_of_mass = [0.0, 0.0, 0.0]
-[materials.aluminium]
-youngs_modulus = 70e9
-poisson_ratio = 0.3
-density = 2700.0
-[[beams]]
-name = "mast"
-parent = "hub"
-root = [1.3, 0.0, 0.0]
-axis = [1.0, 0.0, 0.0]
-length = 8.0
-material = "aluminium"
-section = { tube = { outer_diameter = 0.2, wall = 0.005 } }
-terms = { bending = 4, torsion = 2, axial = 2 }
-[[plates]]
-name = "wing"
-parent = "mast"
-station = 8.0
-length_axis = [0.0, -1.0, 0.0]
-normal = [1.0, 0.0, 0.0]
-length = 6.0
-width = 1.0
-areal_density = 10.0
-bending_stiffness = 1.0e4
-poisson_ratio = 0.3
-terms = { length = 4, width = 2 }
-[deployment]
-plate = "wing"
-panels = 3
-end_time = 6.0
-output_rate = 1000.0
-tolerance = 1e-12
-[deployment.hinge]
-stiffness = 2.0
-preload_angle = 0.5
-[deployment.latch]
-model = "compliant"
-stiffness = 1.0e4
-damping = 200.0
-settle_time = 1.0
-"#;
+/// The mast case with latches k_L = 1e4 N·m/rad, c_L = 200 N·m·s/rad, sampled at 1 kHz for
+/// 6 s.
+fn planar_compliant_case() -> String {
+    planar_compliant("", 6.0, 1000.0, 1.0e4, 200.0)
+}
 
 /// Compliant latches on the free hub with the elastic mast: the coupled model
 /// (`simulate_coupled`: minimal coordinates, the base by its floating-frame Ritz model,
@@ -433,7 +364,7 @@ settle_time = 1.0
 /// mast function space (Legendre rod/bending Ritz functions, axial 2, bending 4).
 #[test]
 fn compliant_latches_agree_with_the_maximal_coordinate_formulation() {
-    let sc = Scenario::from_toml_str(PLANAR_COMPLIANT, "planar.toml").unwrap();
+    let sc = Scenario::from_toml_str(&planar_compliant_case(), "planar.toml").unwrap();
     let d = sc.deployment.as_ref().unwrap();
     let (_, r) = simulate_coupled(&sc.structure, d).unwrap();
     let mut case = super::coupled_maximal::reference_case();

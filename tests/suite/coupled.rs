@@ -126,7 +126,7 @@ fn elastic_base_conserves_momentum_and_energy_and_latches_lose_the_metric_energy
 /// ([`super::coupled_maximal::reference_case`]) as a scenario: free 1500 kg hub, 8 m
 /// aluminium tube mast along x from (1.3, 0, 0), three 2 m 20 kg panels at its tip folding in
 /// the x–y plane (e_a = −y, n = x, hinge axes along z).
-const PLANAR_CASE: &str = r#"
+pub const PLANAR_CASE: &str = r#"
 name = "planar case of the second formulation"
 format_version = 1
 [hub]
