@@ -5,6 +5,7 @@
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{self, DeployError, DeploymentResult};
 use crate::response::channels::standard_channels;
+use crate::response::loads::{beam_root_channels, latch_channels};
 use crate::response::handover::hand_over_coupled;
 use crate::response::{Channel, Handover, ModalResponse, ResponseError, ResponseHistory};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
@@ -125,7 +126,9 @@ impl Simulation {
                         });
                     }
                 }
-                let channels = standard_channels(&model);
+                let mut channels = standard_channels(&model);
+                channels.extend(beam_root_channels(&model));
+                channels.extend(latch_channels(&model, &d.plate, &d.chain.hinges));
                 let history = modal.sample(&modes, &channels, settings);
                 warnings.extend(large_deflections(&model, &channels, &history));
                 Some(Response {

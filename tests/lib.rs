@@ -23,4 +23,5 @@ mod suite {
     pub mod plates;
     pub mod report;
     pub mod response;
+    pub mod response_loads;
 }

@@ -102,13 +102,13 @@ impl BaseModel {
         let beams = (0..base_st.beams.len())
             .map(|i| {
                 let b = &base_st.beams[i];
-                let inside = |id: ComponentId| is_in_subtree(&base_st, id, i);
+                let inside = |id: ComponentId| base_st.in_subtree(id, i);
                 let tip = |k: usize| beam_point(&ritz, i, 1.0, &shapes[k]).unwrap_or_default();
                 let root = |k: usize| beam_point(&ritz, i, 0.0, &shapes[k]).unwrap_or_default();
                 let carries = match deploying.attachment {
                     Attachment::Hub { .. } => false,
                     Attachment::Beam { beam, .. } => {
-                        beam == i || is_in_subtree(&base_st, ComponentId::Beam(beam), i)
+                        beam == i || base_st.in_subtree(ComponentId::Beam(beam), i)
                     }
                 };
                 BaseBeam {
@@ -196,24 +196,6 @@ fn section_motion(
         rot.push(th);
     }
     (point, disp, rot)
-}
-
-/// Component `id` is beam `root`, or hangs (through any chain of parents) on it.
-fn is_in_subtree(st: &Structure, id: ComponentId, root: usize) -> bool {
-    let mut att = match id {
-        ComponentId::Hub => return false,
-        ComponentId::Beam(i) if i == root => return true,
-        ComponentId::Beam(i) => &st.beams[i].attachment,
-        ComponentId::Plate(i) => &st.plates[i].attachment,
-        ComponentId::Mass(i) => &st.masses[i].attachment,
-    };
-    loop {
-        match att {
-            Attachment::Hub { .. } => return false,
-            Attachment::Beam { beam, .. } if *beam == root => return true,
-            Attachment::Beam { beam, .. } => att = &st.beams[*beam].attachment,
-        }
-    }
 }
 
 /// The base's mass points, each tagged with its component.

@@ -28,6 +28,26 @@ pub enum ChannelKind {
     HubTranslation,
     /// Hub rotation, rad.
     HubRotation,
+    /// The force (N) or moment (N·m) a beam's parent exerts on it at its root
+    /// ([`super::loads`]).
+    BeamRoot {
+        /// Beam name.
+        beam: String,
+    },
+    /// A latch's moment on its hinge (N·m) in the deployed wing ([`super::loads`]).
+    LatchMoment {
+        /// Hinge number, 1 at the root.
+        hinge: usize,
+    },
+}
+
+/// Which time derivative of q a channel's row multiplies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Order {
+    /// value = c · q + offset (deflections, rotations).
+    Displacement,
+    /// value = c · q̈ + offset (loads by force summation: momentum rates).
+    Acceleration,
 }
 
 /// One recorded quantity.
@@ -41,8 +61,12 @@ pub struct Channel {
     pub unit: &'static str,
     /// Group.
     pub kind: ChannelKind,
-    /// The row c: value = c · q.
+    /// The row c: value = c · q (or c · q̈, see `order`) + `offset`.
     pub row: Vec<f64>,
+    /// The derivative of q the row multiplies.
+    pub order: Order,
+    /// A constant added to c · q (or c · q̈): a static part the linear model does not carry.
+    pub offset: f64,
 }
 
 /// The standard channels of a model: beams' tips, plates' tip corners, the hub.
@@ -80,6 +104,8 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                         unit,
                         kind: ChannelKind::BeamTip { beam: name.clone() },
                         row,
+                        order: Order::Displacement,
+                        offset: 0.0,
                     });
                 }
             }
@@ -108,6 +134,8 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                             plate: name.clone(),
                         },
                         row,
+                        order: Order::Displacement,
+                        offset: 0.0,
                     });
                 }
             }
@@ -140,6 +168,8 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                 unit,
                 kind: kind.clone(),
                 row,
+                order: Order::Displacement,
+                offset: 0.0,
             });
         }
     }

@@ -1,13 +1,15 @@
 //! The latch-excited vibration of the deployed spacecraft (MODEL.md §3.3; the paper's
 //! section 2.2 end and figures 2.4–2.7): the hand-over from the deploying chain to the
 //! flexible model ([`handover`]), the response by exact modal superposition
-//! ([`superposition`]), and the physical quantities sampled from it ([`channels`]).
+//! ([`superposition`]), and the physical quantities sampled from it ([`channels`]), loads
+//! included ([`loads`]).
 
 pub mod channels;
 pub mod handover;
+pub mod loads;
 pub mod superposition;
 
-pub use channels::{Channel, ChannelKind};
+pub use channels::{Channel, ChannelKind, Order};
 pub use handover::{hand_over, Handover, HandoverMethod, Momentum};
 pub use superposition::{ModalResponse, ResponseHistory};
 

@@ -10,7 +10,7 @@
 //! No time stepping: an undamped mode keeps its energy ½(η̇² + ω²η²) to rounding for any
 //! duration, and the samples t_k = k/rate are exact.
 
-use super::channels::Channel;
+use super::channels::{Channel, Order};
 use super::ResponseSettings;
 use crate::ritz::ModalAnalysis;
 use faer::Mat;
@@ -131,28 +131,48 @@ impl ModalResponse {
         let rows = settings.rows() as usize;
         let nm = self.modes.len();
         let times: Vec<f64> = (0..rows).map(|k| k as f64 / settings.output_rate).collect();
-        // Channel gains G_jc = c · φ_j.
-        let gains = Mat::from_fn(nm, channels.len(), |j, c| {
-            let shape = &modal.modes[self.modes[j].number - 1].shape;
-            channels[c]
-                .row
-                .iter()
-                .zip(shape)
-                .map(|(a, b)| a * b)
-                .sum::<f64>()
-        });
+        // Channel gains G_jc = c · φ_j, split by the derivative each channel reads.
+        let gain = |order: Order| {
+            Mat::from_fn(nm, channels.len(), |j, c| {
+                if channels[c].order != order {
+                    return 0.0;
+                }
+                let shape = &modal.modes[self.modes[j].number - 1].shape;
+                channels[c]
+                    .row
+                    .iter()
+                    .zip(shape)
+                    .map(|(a, b)| a * b)
+                    .sum::<f64>()
+            })
+        };
         let mut eta = Mat::<f64>::zeros(rows, nm);
+        let mut eta_dd = Mat::<f64>::zeros(rows, nm);
         let mut energy = vec![0.0; rows];
         let h = 1.0 / settings.output_rate;
+        let mut acc = vec![0.0; rows];
         for (j, m) in self.modes.iter().enumerate() {
             let col = eta
                 .col_mut(j)
                 .try_as_col_major_mut()
                 .expect("a fresh Mat is column-major")
                 .as_slice_mut();
-            fill_mode(m, self.damping_ratio, h, col, &mut energy);
+            fill_mode(m, self.damping_ratio, h, col, &mut acc, &mut energy);
+            for (k, a) in acc.iter().enumerate() {
+                eta_dd[(k, j)] = *a;
+            }
         }
-        let values = &eta * &gains;
+        let mut values = &eta * gain(Order::Displacement);
+        if channels.iter().any(|c| c.order == Order::Acceleration) {
+            values += &eta_dd * gain(Order::Acceleration);
+        }
+        for (c, ch) in channels.iter().enumerate() {
+            if ch.offset != 0.0 {
+                for k in 0..rows {
+                    values[(k, c)] += ch.offset;
+                }
+            }
+        }
         ResponseHistory {
             times,
             values,
@@ -162,16 +182,25 @@ impl ModalResponse {
     }
 }
 
-/// Samples at t_k = k·h of one mode into `eta`, adding its energy to `energy` (elastic modes).
+/// Samples at t_k = k·h of one mode into `eta` and its acceleration
+/// η̈ = −2ζωη̇ − ω²η into `eta_dd`, adding its energy to `energy` (elastic modes).
 /// Within blocks of [`RESYNC`] samples the phase advances by the rotation
 /// (cos, sin)(θ + ω_d h) = (c cos ω_d h − s sin ω_d h, s cos ω_d h + c sin ω_d h) and the decay
 /// by the factor e^{−ζωh}; each block starts from the closed form at t = k·h, so rounding
 /// cannot accumulate beyond RESYNC steps (≈ 1e-14 relative).
-fn fill_mode(m: &KeptMode, zeta: f64, h: f64, eta: &mut [f64], energy: &mut [f64]) {
+fn fill_mode(
+    m: &KeptMode,
+    zeta: f64,
+    h: f64,
+    eta: &mut [f64],
+    eta_dd: &mut [f64],
+    energy: &mut [f64],
+) {
     if m.rigid || m.omega_rad_s == 0.0 {
         for (k, e) in eta.iter_mut().enumerate() {
             *e = m.eta0 + m.eta_dot0 * (k as f64 * h);
         }
+        eta_dd.fill(0.0);
         return;
     }
     let w = m.omega_rad_s;
@@ -188,6 +217,7 @@ fn fill_mode(m: &KeptMode, zeta: f64, h: f64, eta: &mut [f64], energy: &mut [f64
             let e = decay * (a * c + b * s);
             let ed = -zeta * w * e + decay * wd * (b * c - a * s);
             eta[k] = e;
+            eta_dd[k] = -2.0 * zeta * w * ed - w * w * e;
             energy[k] += 0.5 * (ed * ed + w * w * e * e);
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
             decay *= step_decay;

@@ -305,6 +305,60 @@ impl RitzModel {
         }
     }
 
+    /// The mass matrix of the components `keep` selects only, M_S = Σ_{e∈S} Bᵀ M_e B (n × n,
+    /// the same coordinates as [`RitzModel::mass`]). Its rows 0–2 and 3–5 are the linear
+    /// momentum of S and its angular momentum about the hub's centre of mass per unit q̇
+    /// (the hub's coordinates are a rigid translation and rotation of everything).
+    pub fn partial_mass(&self, keep: impl Fn(ComponentId) -> bool) -> Mat<f64> {
+        let n = self.dof();
+        let st = &self.structure;
+        let mut mass = Mat::<f64>::zeros(n, n);
+        let mut unused = Mat::<f64>::zeros(n, n);
+        for e in self.elements.iter().filter(|e| keep(e.id)) {
+            let own = e.own_range().start;
+            match (&e.kind, e.id) {
+                (
+                    ElementKind::Beam {
+                        index,
+                        axial,
+                        bending,
+                        torsion,
+                    },
+                    _,
+                ) => {
+                    let (me, ke) = beam_element(
+                        &st.beams[*index],
+                        axial.as_ref(),
+                        bending.as_ref(),
+                        torsion.as_ref(),
+                    );
+                    add_element(&mut mass, &mut unused, &e.attachment, own, &me, &ke);
+                }
+                (
+                    ElementKind::Plate {
+                        index,
+                        length,
+                        width,
+                    },
+                    _,
+                ) => {
+                    let (me, ke) =
+                        plate_element(&st.plates[*index], length.as_ref(), width.as_ref());
+                    add_element(&mut mass, &mut unused, &e.attachment, own, &me, &ke);
+                }
+                (ElementKind::Rigid, ComponentId::Hub) => {
+                    add_rigid(&mut mass, &e.attachment, &st.hub.rigid_body());
+                }
+                (ElementKind::Rigid, ComponentId::Mass(i)) => {
+                    add_rigid(&mut mass, &e.attachment, &st.masses[i].rigid_body());
+                }
+                (ElementKind::Rigid, _) => {}
+            }
+        }
+        symmetrize(&mut mass);
+        mass
+    }
+
     /// The element of a component.
     pub fn element(&self, id: ComponentId) -> Option<&Element> {
         self.elements.iter().find(|e| e.id == id)

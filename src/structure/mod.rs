@@ -215,6 +215,24 @@ impl Structure {
         self.attachment_point(&self.beams[i].attachment)
     }
 
+    /// Component `id` is beam `root`, or hangs on it through any chain of parents.
+    pub fn in_subtree(&self, id: ComponentId, root: usize) -> bool {
+        let mut att = match id {
+            ComponentId::Hub => return false,
+            ComponentId::Beam(i) if i == root => return true,
+            ComponentId::Beam(i) => &self.beams[i].attachment,
+            ComponentId::Plate(i) => &self.plates[i].attachment,
+            ComponentId::Mass(i) => &self.masses[i].attachment,
+        };
+        loop {
+            match att {
+                Attachment::Hub { .. } => return false,
+                Attachment::Beam { beam, .. } if *beam == root => return true,
+                Attachment::Beam { beam, .. } => att = &self.beams[*beam].attachment,
+            }
+        }
+    }
+
     /// Every component's name, in the order hub, beams, plates, masses.
     pub fn component_name(&self, id: ComponentId) -> &str {
         match id {

@@ -13,15 +13,15 @@ use flexcraft::{ModalAnalysis, RitzModel};
 
 const SEED: &str = include_str!("../../examples/seed.toml");
 
-const E: f64 = 70e9;
-const RHO: f64 = 2700.0;
-const AREA: f64 = 1e-3;
-const IY: f64 = 1e-8;
-const L: f64 = 2.0;
+pub const E: f64 = 70e9;
+pub const RHO: f64 = 2700.0;
+pub const AREA: f64 = 1e-3;
+pub const IY: f64 = 1e-8;
+pub const L: f64 = 2.0;
 
 /// A cantilever along x on a fixed hub; w (along z) bends about y with EI_y. The other
 /// fields are made stiff so that the first five elastic modes are the w modes.
-fn cantilever() -> String {
+pub fn cantilever() -> String {
     format!(
         r#"
 name = "cantilever"

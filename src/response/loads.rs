@@ -1,0 +1,149 @@
+//! Internal loads of the vibrating spacecraft by force summation (the "mode-acceleration"
+//! load recovery of structural dynamics): the load a part of the structure receives through
+//! its one cut is the rate of change of that part's momentum, since nothing else acts on a
+//! free-floating spacecraft. Both are linear in the accelerations q̈, so each load is a
+//! channel row c with value c · q̈ (docs/theory.md, "Loads in the response").
+//!
+//! * **Beam root loads.** For beam i and the set S of components hanging on it (itself
+//!   included), the momentum of S is p_S = M_S[0..3, :] q̇ and its angular momentum about the
+//!   hub's centre of mass c is H_S = M_S[3..6, :] q̇, with M_S the mass matrix of S alone
+//!   ([`RitzModel::partial_mass`]); the hub coordinates are a rigid translation and a rigid
+//!   rotation about c of everything. The force the parent exerts on the beam is F = ṗ_S and
+//!   the moment about the root point r is M = Ḣ_S − (r − c) × F (small motions: the root's
+//!   own velocity times p_S is of second order). Structure axes (the hub's body axes).
+//! * **Latch moments in the deployed wing.** The wing is one plate in the response; the
+//!   hinge line k at x_k = (k − 1) a/N carries the moment T_b = Ḣ_b the inboard part exerts
+//!   on the outboard strip x ∈ [x_k, a] about the width axis e_b, with
+//!   H_b = −μ ∫∫_{x ≥ x_k} (x − x_k) v_n dA and v_n = n·(U̇ + Θ̇ × r) + Ẇ the normal velocity
+//!   (the attachment's translation U and rotation Θ, r from the root edge's centre). On the
+//!   hinge coordinate α_k (whose opening turns the outboard panels by (−1)^k about
+//!   e_a × n = −e_b) this is the generalized moment Q_k = (−1)^{k+1} T_b: the hinge spring and
+//!   the latch together. The latch's share is Q_k minus the hinge spring's moment at the
+//!   latch angle, the static preload the unstressed plate does not carry, so that a settled
+//!   deployment and the response's start agree.
+
+use super::channels::{Channel, ChannelKind, Order};
+use crate::basis::{Basis1d, Quadrature};
+use crate::deploy::chain::Hinge;
+use crate::math::Vec3;
+use crate::ritz::assembly::ElementKind;
+use crate::ritz::RitzModel;
+use crate::structure::ComponentId;
+
+/// Every beam's root force (N) and moment (N·m) about its root point, structure axes: six
+/// acceleration channels per beam, `<beam>_root_fx` … `<beam>_root_mz`.
+pub fn beam_root_channels(model: &RitzModel) -> Vec<Channel> {
+    let st = &model.structure;
+    let c = st.hub.center_of_mass;
+    let mut out = Vec::new();
+    for (i, beam) in st.beams.iter().enumerate() {
+        let ms = model.partial_mass(|id| st.in_subtree(id, i));
+        let d = st.beam_root(i) - c;
+        let n = model.dof();
+        let col = |j: usize, first: usize| Vec3::new(ms[(first, j)], ms[(first + 1, j)], ms[(first + 2, j)]);
+        // Column j: F_j = p-rows, M_j = H-rows − d × F_j.
+        let (mut f, mut m) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        for j in 0..n {
+            let fj = col(j, 0);
+            let mj = col(j, 3) - d.cross(fj);
+            f[j] = fj.0;
+            m[j] = mj.0;
+        }
+        for (rows, what, unit) in [(&f, "f", "N"), (&m, "m", "N·m")] {
+            for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+                out.push(Channel {
+                    name: format!("{}_root_{what}{axis}", beam.name),
+                    label: format!(
+                        "{} root {} {axis}",
+                        beam.name,
+                        if what == "f" { "force" } else { "moment" }
+                    ),
+                    unit,
+                    kind: ChannelKind::BeamRoot {
+                        beam: beam.name.clone(),
+                    },
+                    row: rows.iter().map(|r| r[k]).collect(),
+                    order: Order::Acceleration,
+                    offset: 0.0,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The latch moments `latch_moment_<k>` (N·m, on the hinge coordinate α_k) of the deployed
+/// wing `plate`, one per hinge of `hinges` (module doc). Empty if the plate is not in the
+/// model.
+pub fn latch_channels(model: &RitzModel, plate: &str, hinges: &[Hinge]) -> Vec<Channel> {
+    let st = &model.structure;
+    let Some(pi) = st.plates.iter().position(|p| p.name == plate) else {
+        return Vec::new();
+    };
+    let Some(e) = model.element(ComponentId::Plate(pi)) else {
+        return Vec::new();
+    };
+    let ElementKind::Plate { length, width, .. } = &e.kind else {
+        return Vec::new();
+    };
+    let p = &st.plates[pi];
+    let (a, b, mu) = (p.length, p.width, p.areal_density);
+    let n_panels = hinges.len().max(1);
+    let y_means = means(width.as_ref(), 0.0, |_| 1.0);
+    let own = e.own_range().start;
+    let ny = width.len();
+    hinges
+        .iter()
+        .enumerate()
+        .map(|(i, h)| {
+            let k = i + 1;
+            let xk = a * i as f64 / n_panels as f64;
+            let a1 = 0.5 * (a - xk).powi(2);
+            let a2 = a.powi(3) / 3.0 - xk * a * a / 2.0 + xk.powi(3) / 6.0;
+            let coef_u = p.normal * (-mu * b * a1);
+            let coef_th = p.width_axis() * (mu * b * a2);
+            let x_moments = means(length.as_ref(), xk / a, |xi| a * xi - xk);
+            let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
+            let t = &e.attachment;
+            let mut row: Vec<f64> = (0..model.dof())
+                .map(|j| {
+                    let u = Vec3::new(t[(0, j)], t[(1, j)], t[(2, j)]);
+                    let th = Vec3::new(t[(3, j)], t[(4, j)], t[(5, j)]);
+                    sign * (coef_u.dot(u) + coef_th.dot(th))
+                })
+                .collect();
+            for (m, xm) in x_moments.iter().enumerate() {
+                for (n, yn) in y_means.iter().enumerate() {
+                    row[own + m * ny + n] += sign * (-mu * b * a * xm * yn);
+                }
+            }
+            Channel {
+                name: format!("latch_moment_{k}"),
+                label: format!("latch moment, hinge {k}"),
+                unit: "N·m",
+                kind: ChannelKind::LatchMoment { hinge: k },
+                row,
+                order: Order::Acceleration,
+                offset: -h.moment(h.latch_angle, 0.0),
+            }
+        })
+        .collect()
+}
+
+/// ∫_{ξ₀}^1 w(ξ) F_m(ξ) dξ for every function F_m of a family, by Gauss–Legendre quadrature on
+/// [ξ₀, 1] (exact for the polynomial families with w linear).
+fn means(basis: &dyn Basis1d, xi0: f64, weight: impl Fn(f64) -> f64) -> Vec<f64> {
+    let q = Quadrature::gauss(basis.len() + 24);
+    let span = 1.0 - xi0;
+    let mut out = vec![0.0; basis.len()];
+    let mut vals = vec![[0.0; 4]; basis.len()];
+    for (&t, &w) in q.points.iter().zip(&q.weights) {
+        let xi = xi0 + span * t;
+        basis.eval_all(xi, &mut vals);
+        let f = w * span * weight(xi);
+        for (o, v) in out.iter_mut().zip(&vals) {
+            *o += f * v[0];
+        }
+    }
+    out
+}
