@@ -5,8 +5,8 @@
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{self, DeployError, DeploymentResult};
 use crate::response::channels::standard_channels;
-use crate::response::loads::{beam_root_channels, latch_channels};
 use crate::response::handover::hand_over_coupled;
+use crate::response::loads::{beam_root_channels, latch_channels};
 use crate::response::{Channel, Handover, ModalResponse, ResponseError, ResponseHistory};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
 use crate::scenario::Scenario;

@@ -248,6 +248,19 @@ impl Engine for Coupled {
     fn kinetic_energy(&self, y: &[f64]) -> f64 {
         Coupled::kinetic_energy(self, y)
     }
+    fn load_magnitudes(&self, y: &[f64], free: &[bool], captured: &[bool]) -> Vec<f64> {
+        let (ev, sol) = self.solve_captured(y, free, captured);
+        let mut out: Vec<f64> = self
+            .latch_moments(y, captured)
+            .iter()
+            .map(|m| m.abs())
+            .collect();
+        for l in self.beam_root_loads(y, &ev, &sol) {
+            out.push(l[..3].iter().map(|x| x * x).sum::<f64>().sqrt());
+            out.push(l[3..].iter().map(|x| x * x).sum::<f64>().sqrt());
+        }
+        out
+    }
     fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample {
         let (ev, sol) = self.solve_captured(y, free, captured);
         let loads = self.hinge_loads(y, &ev, &sol);

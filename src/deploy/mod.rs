@@ -12,6 +12,7 @@ pub(crate) mod events;
 pub mod inertia;
 pub(crate) mod integrator;
 pub mod loads;
+pub mod peaks;
 pub mod planar;
 pub(crate) mod rosenbrock;
 mod run;
@@ -310,6 +311,10 @@ pub struct DeploymentResult {
     pub warnings: Vec<Warning>,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
+    /// Peaks of the engine's tracked load magnitudes ([`peaks`]), observed at every step
+    /// (coupled model: every hinge's latch moment, then every base beam's root force and
+    /// root moment).
+    pub load_peaks: Vec<peaks::Peak>,
 }
 
 impl DeploymentResult {

@@ -7,6 +7,7 @@
 use super::chain::{Chain, Hinge, PlanarHub, P2};
 use super::events::{self, Crossing};
 use super::integrator::{DenseStep, Dopri5, OdeSystem};
+use super::peaks::PeakTracker;
 use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
 use super::Integrator;
@@ -54,6 +55,11 @@ pub(crate) trait Engine {
     fn kinetic_energy(&self, y: &[f64]) -> f64;
     /// The sample at time t.
     fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample;
+    /// Load magnitudes whose peaks the run tracks at every step ([`super::peaks`]); none by
+    /// default.
+    fn load_magnitudes(&self, _y: &[f64], _free: &[bool], _captured: &[bool]) -> Vec<f64> {
+        Vec::new()
+    }
 }
 
 /// The planar chain of [`super::chain`] as an engine: y = [q, q̇].
@@ -217,6 +223,7 @@ struct Run<'a, E: Engine> {
     latches: Vec<LatchEvent>,
     captures: Vec<Capture>,
     swing: SwingTracker,
+    peaks: PeakTracker,
     buf: Vec<f64>,
     warnings: Vec<Warning>,
 }
@@ -231,6 +238,8 @@ impl<'a, E: Engine> Run<'a, E> {
             captured: vec![false; hinges.len()],
         };
         let samples = vec![engine.sample(0.0, &y, &sys.free, &sys.captured)];
+        let mut peaks = PeakTracker::default();
+        peaks.observe(0.0, &engine.load_magnitudes(&y, &sys.free, &sys.captured));
         let len = y.len();
         Self {
             s,
@@ -244,6 +253,7 @@ impl<'a, E: Engine> Run<'a, E> {
             latches: Vec::new(),
             captures: Vec::new(),
             swing: SwingTracker::new(hinges.iter().map(|j| j.initial_angle).collect()),
+            peaks,
             buf: vec![0.0; len],
             warnings: Vec::new(),
         }
@@ -303,6 +313,7 @@ impl<'a, E: Engine> Run<'a, E> {
             None => {
                 let r = self.alpha_range();
                 self.swing.observe(self.t, &self.y[r]);
+                self.observe_loads();
             }
             Some(e) if self.sys.engine.compliant() => self.capture(&step, e),
             Some(e) => self.latch(&step, e),
@@ -319,6 +330,8 @@ impl<'a, E: Engine> Run<'a, E> {
         let ro = engine.positions() + engine.rate_offset();
         step.eval(e.t, &mut self.y);
         self.t = e.t;
+        self.observe_loads();
+        self.peaks.break_history();
         let open = self.sys.open();
         // A compliant latch captures its hinge when the hinge reaches it; "simultaneous"
         // latching does not apply (it would pull bent hinges onto their latch angles), and
@@ -336,11 +349,21 @@ impl<'a, E: Engine> Run<'a, E> {
         }
         // The hinge sits on its latch angle (to the event tolerance): put it there exactly.
         self.y[off + e.hinge] = self.latch_angles[e.hinge];
+        self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
             self.samples
                 .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
         }
         self.solver.restart();
+    }
+
+    /// Observes the tracked load magnitudes at the current state.
+    fn observe_loads(&mut self) {
+        let m = self
+            .sys
+            .engine
+            .load_magnitudes(&self.y, &self.sys.free, &self.sys.captured);
+        self.peaks.observe(self.t, &m);
     }
 
     /// Samples at k / rate within (step.t0, t_limit].
@@ -353,6 +376,11 @@ impl<'a, E: Engine> Run<'a, E> {
             }
             step.eval(tk, &mut self.buf);
             self.swing.observe(tk, &self.buf[r.clone()]);
+            let m = self
+                .sys
+                .engine
+                .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
+            self.peaks.observe(tk, &m);
             self.samples.push(self.sys.engine.sample(
                 tk,
                 &self.buf,
@@ -389,6 +417,8 @@ impl<'a, E: Engine> Run<'a, E> {
         if all && !cable {
             self.bent_lock_warning(e);
         }
+        self.observe_loads();
+        self.peaks.break_history();
         let before = engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured);
         let energy_before = engine.kinetic_energy(&self.y);
         let (u_new, impulses) = engine.impact(&self.y, &free_after);
@@ -418,6 +448,7 @@ impl<'a, E: Engine> Run<'a, E> {
         };
         self.latches.push(event);
         self.sys.free = free_after;
+        self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
             self.samples.push(before);
         }
@@ -495,6 +526,7 @@ impl<'a, E: Engine> Run<'a, E> {
             swing_back,
             warnings,
             evaluations: self.solver.evaluations(),
+            load_peaks: self.peaks.peaks().to_vec(),
         }
     }
 }

@@ -41,32 +41,30 @@ fn hub_json(c: &Coupled, r: &DeploymentResult) -> Value {
     }
 }
 
-/// Per base beam, the largest magnitude of its root force (N) and root moment (N·m) over
-/// the deployment's samples, with their times.
+pub use crate::deploy::peaks::Peak;
+
+/// Per base beam: its name and the largest magnitude of its root force (N) and root moment
+/// (N·m) over the deployment, with their times: tracked at every integration step
+/// (`DeploymentResult::load_peaks`: the hinges' latch moments, then each beam's force and
+/// moment).
+pub fn root_load_peaks(c: &Coupled, r: &DeploymentResult) -> Vec<(String, Peak, Peak)> {
+    let n = c.panels();
+    let at = |i: usize| r.load_peaks.get(i).copied().unwrap_or((0.0, 0.0));
+    c.base
+        .beams
+        .iter()
+        .enumerate()
+        .map(|(b, beam)| (beam.name.clone(), at(n + 2 * b), at(n + 2 * b + 1)))
+        .collect()
+}
+
+/// [`root_load_peaks`] as JSON.
 pub fn peak_root_loads(c: &Coupled, r: &DeploymentResult) -> Value {
-    let peak = |b: usize, range: std::ops::Range<usize>| {
-        r.samples
-            .iter()
-            .filter_map(|s| {
-                s.body.as_deref().map(|body| {
-                    let l = &body.root_loads[b];
-                    (
-                        l[range.clone()].iter().map(|x| x * x).sum::<f64>().sqrt(),
-                        s.t,
-                    )
-                })
-            })
-            .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a })
-    };
     Value::Array(
-        c.base
-            .beams
-            .iter()
-            .enumerate()
-            .map(|(b, beam)| {
-                let (f, tf) = peak(b, 0..3);
-                let (m, tm) = peak(b, 3..6);
-                json!({"beam": beam.name, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
+        root_load_peaks(c, r)
+            .into_iter()
+            .map(|(beam, (f, tf), (m, tm))| {
+                json!({"beam": beam, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
             })
             .collect(),
     )
@@ -95,23 +93,23 @@ pub fn peak_hinge_reactions(r: &DeploymentResult) -> Value {
     )
 }
 
-/// Per hinge, the largest compliant-latch moment magnitude (N·m) over the samples and its
-/// time (empty with rigid latches).
-pub fn peak_latch_moments(r: &DeploymentResult) -> Value {
+/// Per hinge, the largest compliant-latch moment magnitude (N·m) over the deployment and
+/// its time, tracked at every integration step (empty with rigid latches).
+pub fn latch_moment_peaks(r: &DeploymentResult) -> Vec<Peak> {
     if r.captures.is_empty() {
-        return Value::Array(Vec::new());
+        return Vec::new();
     }
     let n = r.samples.first().map_or(0, |s| s.latch_moment.len());
+    r.load_peaks.iter().take(n).copied().collect()
+}
+
+/// [`latch_moment_peaks`] as JSON.
+pub fn peak_latch_moments(r: &DeploymentResult) -> Value {
     Value::Array(
-        (0..n)
-            .map(|i| {
-                let (m, t) = r
-                    .samples
-                    .iter()
-                    .map(|s| (s.latch_moment[i].abs(), s.t))
-                    .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a });
-                json!({"hinge": i + 1, "moment": m, "time": t})
-            })
+        latch_moment_peaks(r)
+            .into_iter()
+            .enumerate()
+            .map(|(i, (m, t))| json!({"hinge": i + 1, "moment": m, "time": t}))
             .collect(),
     )
 }

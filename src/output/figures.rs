@@ -119,7 +119,11 @@ pub fn deployment_figures(
     let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
     let m = r.samples.len();
     let t = |k: usize| r.samples[k].t;
-    let markers: Vec<f64> = r.latches.iter().map(|e| e.time).collect();
+    // Rigid latches and compliant captures (one marker per instant).
+    let mut markers: Vec<f64> = r.latches.iter().map(|e| e.time).collect();
+    markers.extend(r.captures.iter().map(|c| c.time));
+    markers.sort_by(f64::total_cmp);
+    markers.dedup();
     let per_hinge = |f: &dyn Fn(&Sample, usize) -> f64| -> Vec<Curve> {
         shown
             .iter()
@@ -155,6 +159,14 @@ pub fn deployment_figures(
             per_hinge(&|s, i| s.force[i][0].hypot(s.force[i][1])),
         ),
     ];
+    if !r.captures.is_empty() {
+        figs.push(fig(
+            "latch_moments",
+            "compliant latch moments on the hinges (captures marked)",
+            "M_L [N·m]",
+            per_hinge(&|s, i| s.latch_moment[i]),
+        ));
+    }
     if body(0).is_none() {
         let hub: Vec<Curve> = ["u [m]", "v [m]", "θ [rad]"]
             .iter()
@@ -344,6 +356,29 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         "rotation [rad]",
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));
+    for (b, stem) in st.beams.iter().zip(&stems) {
+        let kind = ChannelKind::BeamRoot {
+            beam: b.name.clone(),
+        };
+        out.push(fig(
+            format!("response_{stem}_root_moment"),
+            format!(
+                "{} root moment (parent on beam, about its root point)",
+                b.name
+            ),
+            "moment [N·m]",
+            pick(&|c| c.kind == kind && c.unit == "N·m"),
+        ));
+    }
+    let latches = pick(&|c| matches!(c.kind, ChannelKind::LatchMoment { .. }));
+    if !latches.is_empty() {
+        out.push(fig(
+            "response_latch_moments".into(),
+            "latch moments in the deployed wing".into(),
+            "moment [N·m]",
+            latches,
+        ));
+    }
     let modal: Vec<Curve> = r
         .modal
         .modes

@@ -1,6 +1,7 @@
 //! `flexcraft simulate` outputs: the terminal summary, summary.json, response.csv and the
 //! response plots (the paper's figures 2.4–2.7 and the modal amplitudes).
 
+use super::deploy::Peak;
 use super::names::csv_writer;
 use super::{deploy_table, modes_json, num, write_deploy, OutputDir, OutputError};
 use crate::math::Vec3;
@@ -77,6 +78,80 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
     })
 }
 
+/// The largest magnitude over the response's samples of the vector made of channels `cs`
+/// (one channel: its absolute value), with its time from release.
+fn response_peak(r: &Response, cs: &[usize]) -> Peak {
+    let h = &r.history;
+    let t0 = r.handover.latch_time;
+    (0..h.times.len())
+        .map(|k| {
+            let v = cs.iter().map(|&c| h.values[(k, c)].powi(2)).sum::<f64>();
+            (v.sqrt(), t0 + h.times[k])
+        })
+        .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a })
+}
+
+fn peak_json(p: Option<Peak>) -> Value {
+    p.map_or(Value::Null, |(v, t)| json!({"value": v, "time": t}))
+}
+
+/// The larger of two peaks and the phase it falls in.
+fn overall(dep: Option<Peak>, resp: Option<Peak>) -> Value {
+    let (p, phase) = match (dep, resp) {
+        (Some(d), Some(r)) if r.0 > d.0 => (r, "response"),
+        (Some(d), _) => (d, "deployment"),
+        (None, Some(r)) => (r, "response"),
+        (None, None) => return Value::Null,
+    };
+    json!({"value": p.0, "time": p.1, "phase": phase})
+}
+
+/// Peak root loads of every beam and peak latch moments, over the deployment and the
+/// response (times from release).
+fn peak_loads(sim: &Simulation) -> Value {
+    let dep = &sim.deployment;
+    let r = sim.response.as_ref();
+    let find = |pred: &dyn Fn(&ChannelKind) -> bool| -> Vec<usize> {
+        r.map_or(Vec::new(), |r| {
+            r.channels
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| pred(&c.kind))
+                .map(|(i, _)| i)
+                .collect()
+        })
+    };
+    let roots: Vec<Value> = super::deploy::root_load_peaks(&sim.coupled, dep)
+        .into_iter()
+        .map(|(beam, f, m)| {
+            let cs = find(&|k| matches!(k, ChannelKind::BeamRoot { beam: b } if *b == beam));
+            let (rf, rm) = match (r, cs.len()) {
+                (Some(r), 6) => (Some(response_peak(r, &cs[..3])), Some(response_peak(r, &cs[3..]))),
+                _ => (None, None),
+            };
+            json!({
+                "beam": beam,
+                "force": {"deployment": peak_json(Some(f)), "response": peak_json(rf), "overall": overall(Some(f), rf)},
+                "moment": {"deployment": peak_json(Some(m)), "response": peak_json(rm), "overall": overall(Some(m), rm)},
+            })
+        })
+        .collect();
+    let dep_latch = super::deploy::latch_moment_peaks(dep);
+    let n = sim.coupled.panels();
+    let latches: Vec<Value> = (0..n)
+        .map(|i| {
+            let d = dep_latch.get(i).copied();
+            let cs = find(&|k| matches!(k, ChannelKind::LatchMoment { hinge } if *hinge == i + 1));
+            let rp = match (r, cs.as_slice()) {
+                (Some(r), [c]) => Some(response_peak(r, &[*c])),
+                _ => None,
+            };
+            json!({"hinge": i + 1, "deployment": peak_json(d), "response": peak_json(rp), "overall": overall(d, rp)})
+        })
+        .collect();
+    json!({"root_loads": roots, "latch_moments": latches})
+}
+
 /// summary.json (and `simulate --json`).
 pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
     let d = s.deployment.as_ref();
@@ -86,6 +161,9 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             "time": "s", "length": "m", "angle": "rad", "energy": "J (kinetic unless stated)",
             "linear_momentum": "N·s", "angular_momentum": "N·m·s, about the hub's centre of mass",
             "frequency": "Hz", "modal_velocity": "√kg·m/s (mass-normalised modes)",
+            "force": "N", "moment": "N·m",
+            "root_loads": "the force a beam's parent exerts on it and the moment about its root point, hub axes",
+            "latch_moment": "the latch's moment on its hinge angle (opening positive); in the response, the wing's moment across the hinge line less the hinge spring's at the latch angle",
             "axes": "structure frame (the hub's body axes at the final latch)",
         },
         "name": s.name,
@@ -112,6 +190,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             "elastic": sim.modes.modes.iter().filter(|m| !m.rigid).count(),
             "first_frequencies_hz": sim.modes.elastic().take(10).map(|m| m.frequency_hz()).collect::<Vec<_>>(),
         },
+        "peak_loads": peak_loads(sim),
         "handover": Value::Null,
         "response": Value::Null,
         "warnings": sim.all_warnings().map(ToString::to_string).collect::<Vec<_>>(),
@@ -261,6 +340,31 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
                 ch.label, p, ch.unit, t
             );
         }
+    }
+    let peaks = peak_loads(sim);
+    let line = |o: &mut String, what: String, unit: &str, p: &Value| {
+        if let (Some(v), Some(t), Some(ph)) =
+            (p["value"].as_f64(), p["time"].as_f64(), p["phase"].as_str())
+        {
+            let _ = writeln!(
+                o,
+                "  peak {what:<34} {v:>13.6e} {unit} at t = {t:.3} s from release ({ph})"
+            );
+        }
+    };
+    for b in peaks["root_loads"].as_array().into_iter().flatten() {
+        let name = b["beam"].as_str().unwrap_or("");
+        line(o, format!("{name} root force"), "N", &b["force"]["overall"]);
+        line(
+            o,
+            format!("{name} root moment"),
+            "N·m",
+            &b["moment"]["overall"],
+        );
+    }
+    for l in peaks["latch_moments"].as_array().into_iter().flatten() {
+        let k = l["hinge"].as_u64().unwrap_or(0);
+        line(o, format!("latch moment, hinge {k}"), "N·m", &l["overall"]);
     }
     let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let finals = |kind: ChannelKind| -> String {

@@ -40,7 +40,9 @@ pub fn beam_root_channels(model: &RitzModel) -> Vec<Channel> {
         let ms = model.partial_mass(|id| st.in_subtree(id, i));
         let d = st.beam_root(i) - c;
         let n = model.dof();
-        let col = |j: usize, first: usize| Vec3::new(ms[(first, j)], ms[(first + 1, j)], ms[(first + 2, j)]);
+        let col = |j: usize, first: usize| {
+            Vec3::new(ms[(first, j)], ms[(first + 1, j)], ms[(first + 2, j)])
+        };
         // Column j: F_j = p-rows, M_j = H-rows − d × F_j.
         let (mut f, mut m) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
         for j in 0..n {

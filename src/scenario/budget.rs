@@ -86,8 +86,7 @@ impl Scenario {
             // Hub (6), every beam's tip (3) and root loads (6), plate corners (2), latch
             // moments (one per panel); η and η̈ of every kept mode.
             let panels = self.deployment.as_ref().map_or(0, |d| d.chain.len() as u64);
-            let channels =
-                6 + 9 * st.beams.len() as u64 + 2 * st.plates.len() as u64 + panels;
+            let channels = 6 + 9 * st.beams.len() as u64 + 2 * st.plates.len() as u64 + panels;
             let modes = self.response.modes.map_or(dof, |m| (m as u64).min(dof));
             self.response
                 .rows()

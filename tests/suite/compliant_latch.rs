@@ -360,7 +360,10 @@ fn planar_compliant_case() -> String {
 /// latch-moment law) agree on the capture order, the capture times and the rates at each
 /// capture, and on the latch moment −k_L (α − α^L) − c_L α̇ of every hinge at every common
 /// 1 kHz output time (each formulation evaluates it at that exact instant, so the peak is
-/// compared where it is, not as sampled by one side), hence on its peak (and on the hinge angles there). Both use the same
+/// compared where it is, not as sampled by one side), hence on its peak (and on the hinge
+/// angles there); and on the mast root moment at those times and its peak, which the coupled
+/// model takes from the momentum rates of everything outboard of the root and the second
+/// formulation from the hub's own equations (−I_h θ̈ + (R − O) × m_h a_O). Both use the same
 /// mast function space (Legendre rod/bending Ritz functions, axial 2, bending 4).
 #[test]
 fn compliant_latches_agree_with_the_maximal_coordinate_formulation() {
@@ -426,11 +429,38 @@ fn compliant_latches_agree_with_the_maximal_coordinate_formulation() {
         .filter(|(_, b)| **b > 0.0)
         .map(|(a, b)| (a - b).abs() / b)
         .fold(0.0f64, f64::max);
+    // The mast root moment about the deployment plane's normal (hub z): theirs from the
+    // momentum rates of everything outboard of the root, mine from the hub's equations.
+    let root_theirs: Vec<f64> = theirs_on_grid
+        .iter()
+        .map(|s| {
+            s.body
+                .as_ref()
+                .expect("coupled samples carry the body")
+                .root_loads[0][5]
+        })
+        .collect();
+    let root_mine: Vec<f64> = m.samples.iter().map(|s| s.root_moment).collect();
+    let root_peak = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let (rp_theirs, rp_mine) = (root_peak(&root_theirs), root_peak(&root_mine));
+    assert!(rp_mine > 1.0, "root moment peak {rp_mine}");
+    let worst_root = root_theirs
+        .iter()
+        .zip(&root_mine)
+        .map(|(a, b)| (a - b).abs() / rp_mine)
+        .fold(0.0f64, f64::max);
+    let worst_root_peak = (rp_theirs - rp_mine).abs() / rp_mine;
     println!(
         "h = {h:.3e}; captures {theirs:?} vs {mine:?}: time rel {worst_time:.1e}, rates \
          {worst_rate:.1e}; peaks {peak_theirs:?} vs {peak_mine:?}: rel {worst_peak:.1e}; \
-         moment at {} samples {worst_moment:.1e} of the peak, α {worst_alpha:.1e} rad",
+         moment at {} samples {worst_moment:.1e} of the peak, α {worst_alpha:.1e} rad; \
+         root moment peak {rp_theirs:.6e} vs {rp_mine:.6e} (rel {worst_root_peak:.1e}), \
+         at the samples {worst_root:.1e} of the peak",
         times.len()
+    );
+    assert!(
+        worst_root_peak <= 1e-6 && worst_root <= 1e-6,
+        "mast root moment: peak rel {worst_root_peak:.1e}, samples {worst_root:.1e}"
     );
     assert!(worst_time <= 1e-8, "capture times: rel {worst_time:.1e}");
     assert!(worst_rate <= 1e-6, "capture rates: rel {worst_rate:.1e}");

@@ -124,6 +124,10 @@ pub struct PlanarSample {
     pub alpha: Vec<f64>,
     /// The compliant latches' moments, N·m (zero before capture).
     pub latch_moment: Vec<f64>,
+    /// The moment about +z the hub exerts on the mast about its root point R, N·m, from the
+    /// hub's own equations (the mast is the only thing touching it):
+    /// M_R = −I_h θ̈ + (R − O) × m_h (Ẍ, Ÿ).
+    pub root_moment: f64,
 }
 
 /// One latch.
@@ -959,10 +963,17 @@ impl<'a> Model<'a> {
                 } else {
                     (q.to_vec(), v.to_vec())
                 };
+                let acc = self.accel(&qs, &vs, locked);
+                let (sn, cs) = qs[2].sin_cos();
+                let rm = c.mast_root;
+                let d = [cs * rm[0] - sn * rm[1], sn * rm[0] + cs * rm[1]];
+                let root_moment =
+                    -c.hub_inertia * acc[2] + c.hub_mass * (d[0] * acc[1] - d[1] * acc[0]);
                 samples.push(PlanarSample {
                     t: ts,
                     alpha: (0..n).map(|i| self.alpha(&qs, i)).collect(),
                     latch_moment: (0..n).map(|i| self.latch_moment(&qs, &vs, i)).collect(),
+                    root_moment,
                 });
             }
         };

@@ -73,7 +73,11 @@ fn cantilever_root_moment_and_shear_match_the_series() {
             let (beta, x1, d2, d3, _) = clamped_free(n);
             let w = beta * beta * scale;
             let amp = p * x1 / (RHO * AREA * L * w);
-            (w, amp * ei * d2 * beta.powi(2) / L.powi(2), amp * ei * d3 * beta.powi(3) / L.powi(3))
+            (
+                w,
+                amp * ei * d2 * beta.powi(2) / L.powi(2),
+                amp * ei * d3 * beta.powi(3) / L.powi(3),
+            )
         })
         .collect();
     let series = |t: f64, which: usize| -> f64 {
