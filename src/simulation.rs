@@ -1,6 +1,6 @@
 //! The end-to-end run behind `flexcraft simulate`: modes of the deployed structure, the
 //! deployment, the hand-over at the final latch and the latch-excited response
-//! (MODEL.md §3; the paper's section 2).
+//! (docs/theory.md; the paper's section 2).
 
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{self, DeployError, DeploymentResult};

@@ -2,7 +2,7 @@
 //! Euler–Bernoulli beam, X'''' = β⁴ X on ξ ∈ [0, 1], for any pair of end conditions,
 //! and the clamped–free rod functions √2 sin((2n−1)πξ/2).
 //!
-//! **Cancellation-free form** (MODEL.md §3.1). The textbook form
+//! **Cancellation-free form** (docs/theory.md §1). The textbook form
 //! cosh βξ − cos βξ − σ(sinh βξ − sin βξ) subtracts numbers of size e^β/2 to obtain a
 //! result of size 1, and has no correct digit left for β ≳ 36 (n ≈ 11). Here every function is
 //! written in the basis
@@ -20,7 +20,7 @@
 //! Functions are normalised to ∫₀¹ X² dξ = 1 (as the classical tables) with the sign of the
 //! classical forms: the first non-zero of X(0), X'(0), X''(0) is positive. Rigid-body
 //! functions come first where the end conditions allow them: free–free has the pair
-//! 1 and √3(2ξ − 1) (MODEL.md §2: the paper omits them, the plate needs them);
+//! 1 and √3(2ξ − 1) (docs/theory.md §1.3: the paper omits them, the plate needs them);
 //! pinned–free has the rotation √3 ξ.
 
 use super::quadrature::Quadrature;
@@ -298,7 +298,7 @@ impl Basis1d for BeamFunctions {
 }
 
 /// Clamped–free rod functions √2 sin((2n−1)πξ/2), n = 1..N: axial and torsion in the
-/// `characteristic` basis (MODEL.md §3.1).
+/// `characteristic` basis (docs/theory.md §1).
 #[derive(Debug, Clone)]
 pub struct RodFunctions {
     n: usize,

@@ -1,4 +1,4 @@
-//! Polynomial Ritz bases built from Legendre polynomials (the default basis, MODEL.md §3.1).
+//! Polynomial Ritz bases built from Legendre polynomials (the default basis, docs/theory.md §1).
 //!
 //! With t = 2ξ − 1 ∈ [−1, 1]:
 //! * bending, clamped at ξ = 0: ψ_k = c_k Q_k(t), Q_k'' = P_k, Q_k(−1) = Q_k'(−1) = 0

@@ -1,4 +1,4 @@
-//! One-dimensional Ritz functions on ξ ∈ [0, 1] and their integrals (MODEL.md §3.1, "Two bases").
+//! One-dimensional Ritz functions on ξ ∈ [0, 1] and their integrals (docs/theory.md §1.3).
 //!
 //! A component of length L uses x = Lξ; derivatives here are with respect to ξ and the
 //! assembly divides by the powers of L.

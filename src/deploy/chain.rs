@@ -1,5 +1,5 @@
 //! The planar accordion chain: kinematics, mass matrix, equations of motion, hinge reactions,
-//! latching impact (MODEL.md §3.2; the paper's (2.1)–(2.6), rederived in minimal coordinates).
+//! latching impact (docs/theory.md §2; the paper's (2.1)–(2.6), rederived in minimal coordinates).
 //!
 //! Coordinates q = [u, v, θ] of a free hub (its centre of mass in the deployment plane, and
 //! its rotation about the hinge-parallel axis) followed by the opening angles α₁…α_N (a fixed
@@ -573,7 +573,7 @@ impl Chain {
 
     /// Plastic impact: the coordinates flagged in `lock` lose their rate; the generalized
     /// momentum of the coordinates that stay free is conserved:
-    /// M_FF q̇⁺_F = (M q̇⁻)_F, q̇⁺ = 0 elsewhere (MODEL.md §3.2). Returns q̇⁺ and the impulse
+    /// M_FF q̇⁺_F = (M q̇⁻)_F, q̇⁺ = 0 elsewhere (docs/theory.md §2). Returns q̇⁺ and the impulse
     /// each hinge carries (linear, from the inboard body on panel i, and angular).
     pub fn impact(&self, q: &[f64], qd: &[f64], free_after: &[bool]) -> (Vec<f64>, Vec<(P2, f64)>) {
         let n = self.dof();

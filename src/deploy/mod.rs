@@ -1,4 +1,4 @@
-//! Deployment of an accordion-folded N-panel array (MODEL.md §3.2): the chain's dynamics
+//! Deployment of an accordion-folded N-panel array (docs/theory.md §2): the chain's dynamics
 //! ([`chain`]), an adaptive integrator with dense output ([`integrator`]), the latch-event
 //! finder ([`events`]), the swing-back tracker ([`swing`]), the chain of a plate of the 3-D
 //! structure ([`planar`]), and the run with latch events,
@@ -246,7 +246,7 @@ pub struct LatchEvent {
     pub half_modes: Option<HalfModes>,
 }
 
-/// A rigid latch's sensitivity to the base's truncation (MODEL.md §3.2: a rigid latch on an
+/// A rigid latch's sensitivity to the base's truncation (docs/theory.md §2: a rigid latch on an
 /// elastic base has no continuum limit).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HalfModes {

@@ -1,5 +1,5 @@
 //! Hand-over from the deploying chain to the flexible model at the final latch
-//! (MODEL.md §3.3).
+//! (docs/theory.md §3).
 //!
 //! *Projection* (default). Just before the final latch the velocity field v⁻ is the chain's:
 //! the hub and every component other than the deploying plate move rigidly with the hub
@@ -195,7 +195,7 @@ impl PanelMotion {
     /// Velocity of the point at distance s from the panel's hinge on the straight wing: the
     /// panel's rigid motion (centre velocity, rate) carried over to its straight position,
     /// which keeps each panel's momentum, angular momentum about its centre and kinetic
-    /// energy when simultaneous latching locks the array bent (MODEL.md §3.3). For the
+    /// energy when simultaneous latching locks the array bent (docs/theory.md §3). For the
     /// straight wing it is the chain's own velocity field.
     fn velocity(&self, s: f64) -> Vec3 {
         self.v_centre + self.v_per_metre * (s - 0.5 * self.length)

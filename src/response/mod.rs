@@ -1,4 +1,4 @@
-//! The latch-excited vibration of the deployed spacecraft (MODEL.md §3.3; the paper's
+//! The latch-excited vibration of the deployed spacecraft (docs/theory.md §3; the paper's
 //! section 2.2 end and figures 2.4–2.7): the hand-over from the deploying chain to the
 //! flexible model ([`handover`]), the response by exact modal superposition
 //! ([`superposition`]), and the physical quantities sampled from it ([`channels`]), loads

@@ -1,4 +1,4 @@
-//! Response by modal superposition, exact in time (MODEL.md §3.3).
+//! Response by modal superposition, exact in time (docs/theory.md §3).
 //!
 //! With q = Σ_j φ_j η_j (mass-normalised modes), every mode obeys
 //! η̈_j + 2ζω_j η̇_j + ω_j² η_j = 0 after the hand-over, solved in closed form:

@@ -1,4 +1,4 @@
-//! Assembly of the Ritz mass and stiffness matrices (MODEL.md §3.1; the paper's (1.2)–(1.5)).
+//! Assembly of the Ritz mass and stiffness matrices (docs/theory.md §1; the paper's (1.2)–(1.5)).
 //!
 //! Generalized coordinates q: the hub's six (translation of its centre of mass, small
 //! rotation vector), then each beam's own coefficients [u, v, w, θ] (parents before children),
@@ -491,7 +491,7 @@ fn set_coupling(me: &mut Mat<f64>, col: usize, du: Vec3, dth: Vec3) {
 
 /// Element matrices over z = [U; Θ; own]: `me` is (6 + n_e)², `ke` is n_e².
 ///
-/// Beam element (MODEL.md §3.1):
+/// Beam element (docs/theory.md §1):
 /// T = ½∫ρA|U̇ + Θ̇ × x e_x + u̇ e_x + v̇ e_y + ẇ e_z|² + ρI_p(Θ̇·e_x + θ̇)² dx,
 /// U = ½∫(EA u'² + EI_z v''² + EI_y w''² + GJ θ'²) dx.
 pub(crate) fn beam_element(
@@ -561,7 +561,7 @@ pub(crate) fn beam_element(
     (me, ke)
 }
 
-/// Plate element (MODEL.md §3.1): W = Σ g_mn X_m(x/a) Y_n(y/b + ½),
+/// Plate element (docs/theory.md §1): W = Σ g_mn X_m(x/a) Y_n(y/b + ½),
 /// T = ½∫μ|U̇ + Θ̇ × r + Ẇ n|² dA,
 /// U = (D/2)∫[W_xx² + W_yy² + 2ν W_xx W_yy + 2(1 − ν) W_xy²] dA
 /// (= (D/2)∫[(ΔW)² − 2(1−ν)(W_xx W_yy − W_xy²)] dA).

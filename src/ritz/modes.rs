@@ -1,4 +1,4 @@
-//! Natural modes of the assembled model (MODEL.md §3.1 "Modes").
+//! Natural modes of the assembled model (docs/theory.md §1.2).
 //!
 //! Because the stiffness acts on the components' own coordinates only (K = diag(0₆, K_ee)
 //! with K_ee positive definite for root-clamped bases), the modes are found by partition

@@ -1,4 +1,4 @@
-//! The deployed spacecraft as a tree of components rooted at the hub (MODEL.md §3.1).
+//! The deployed spacecraft as a tree of components rooted at the hub (docs/theory.md §1).
 
 pub mod components;
 mod error;

@@ -1,4 +1,4 @@
-//! The compliant latch (MODEL.md §3.2, "Compliant latch"; issue 19) against closed forms.
+//! The compliant latch (docs/theory.md §2.3a; issue 19) against closed forms.
 
 use flexcraft::deploy::simulate_coupled;
 use flexcraft::Scenario;

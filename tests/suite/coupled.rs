@@ -1,4 +1,4 @@
-//! The coupled deployment (MODEL.md §3.2: the array on the flexible, free-floating base as one
+//! The coupled deployment (docs/theory.md §2: the array on the flexible, free-floating base as one
 //! system) against independent truths: the planar chain of `deploy::chain` in the rigid
 //! limit, and conservation laws on an elastic base.
 

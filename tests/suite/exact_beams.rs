@@ -1,5 +1,5 @@
 //! Beams with lumped and hub inertia against their exact transcendental frequency equations
-//! (Euler–Bernoulli, no rotary inertia of the section, as MODEL.md §3.1).
+//! (Euler–Bernoulli, no rotary inertia of the section, as docs/theory.md §1).
 //!
 //! With EI W'''' = ρA ω² W, β⁴ = ρA ω²/EI and W = A cosh βs + B sinh βs + C cos βs + D sin βs
 //! (or the root-clamped combination), the natural boundary conditions follow from the

@@ -4,7 +4,7 @@
 //! * Converged values: λ₁ = 3.4710 for the square plate (Gorman's superposition solutions,
 //!   D. J. Gorman, *Free Vibration Analysis of Rectangular Plates*, Elsevier 1982; also R. Li
 //!   et al., "On new analytic free vibration solutions of rectangular thin cantilever plates
-//!   in the symplectic space", Appl. Math. Modelling 53 (2018) 310–318), quoted in MODEL.md §4.
+//!   in the symplectic space", Appl. Math. Modelling 53 (2018) 310–318).
 //! * Upper bounds: A. W. Leissa, *Vibration of Plates*, NASA SP-160 (1969), table 4.61 /
 //!   Barton (1951), square plate: 3.492, 8.525, 21.43, 27.33, 31.11, 54.44 (also code_aster
 //!   validation case SDLS01). These beam-function Ritz values are ≈ 0.6 % high.

@@ -1,4 +1,4 @@
-//! Latch-excited response (issue 4, MODEL.md §3.3): a series solution, conservation of
+//! Latch-excited response (issue 4, docs/theory.md §3): a series solution, conservation of
 //! momentum through the hand-over and the response, energy conservation and the energy
 //! balance of damped modes.
 
