@@ -21,6 +21,7 @@ mod suite {
     pub mod mutations;
     pub mod output_dir;
     pub mod plates;
+    pub mod plots;
     pub mod report;
     pub mod response;
     pub mod response_loads;

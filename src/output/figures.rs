@@ -62,6 +62,87 @@ fn curve(name: String, n: usize, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> 
     (name, xs, ys)
 }
 
+/// Curves whose largest magnitude is below this fraction of the largest of the same
+/// quantity in the run are rounding noise: drawn as exact zero and labelled so.
+pub const NOISE_FLOOR: f64 = 1e-9;
+
+/// The unit of a curve: the last "[…]" of its name, else of the figure's y label.
+fn unit_of<'a>(name: &'a str, ylabel: &'a str) -> Option<&'a str> {
+    let last = |s: &'a str| {
+        let a = s.rfind('[')?;
+        let b = s[a..].find(']')? + a;
+        Some(&s[a + 1..b])
+    };
+    last(name).or_else(|| last(ylabel))
+}
+
+/// The label a curve of rounding noise gets.
+pub const ZERO_LABEL: &str = "identically zero (rounding only)";
+
+/// Rounding noise and coinciding traces, over one phase's figures (deployment or response):
+/// * a curve whose peak magnitude is at most [`NOISE_FLOOR`] times the largest peak of the
+///   same quantity among `figs` becomes exactly zero, its name ending in [`ZERO_LABEL`];
+///   lengths (m) and angles (rad) are one quantity through `length` (a structure's size:
+///   1 rad of rotation ~ `length` m), so that a twist of 1e-17 rad next to deflections of
+///   1e-5 m reads as the rounding it is;
+/// * a curve equal to an earlier one of the same figure (to 1e-12 of their peak) is noted
+///   "(coincides with …)", since it is drawn under it.
+pub fn clean(figs: &mut [Figure], length: f64) {
+    let peak = |c: &Curve| c.2.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+    let as_length = |unit: &str, p: f64| match unit {
+        "rad" => p * length,
+        _ => p,
+    };
+    fn family(unit: &str) -> &str {
+        if unit == "rad" {
+            "m"
+        } else {
+            unit
+        }
+    }
+    let mut reference: std::collections::BTreeMap<String, f64> = Default::default();
+    for f in figs.iter() {
+        for c in &f.curves {
+            if let Some(u) = unit_of(&c.0, f.ylabel) {
+                let e = reference.entry(family(u).to_string()).or_insert(0.0);
+                *e = e.max(as_length(u, peak(c)));
+            }
+        }
+    }
+    for f in figs.iter_mut() {
+        let ylabel = f.ylabel;
+        for c in f.curves.iter_mut() {
+            let Some(u) = unit_of(&c.0, ylabel) else {
+                continue;
+            };
+            let r = reference.get(family(u)).copied().unwrap_or(0.0);
+            let p = as_length(u, peak(c));
+            if r > 0.0 && p <= NOISE_FLOOR * r && p > 0.0 {
+                c.2.iter_mut().for_each(|v| *v = 0.0);
+                c.0 = format!("{}: {ZERO_LABEL}", c.0);
+            } else if p == 0.0 && !c.0.ends_with(ZERO_LABEL) {
+                c.0 = format!("{}: identically zero", c.0);
+            }
+        }
+        for i in 1..f.curves.len() {
+            let same = (0..i).find(|&j| {
+                let (a, b) = (&f.curves[i], &f.curves[j]);
+                let scale = peak(a).max(peak(b));
+                a.1 == b.1
+                    && scale > 0.0
+                    && a.2
+                        .iter()
+                        .zip(&b.2)
+                        .all(|(x, y)| (x - y).abs() <= 1e-12 * scale)
+            });
+            if let Some(j) = same {
+                let other = f.curves[j].0.clone();
+                f.curves[i].0 = format!("{} (coincides with {other})", f.curves[i].0);
+            }
+        }
+    }
+}
+
 /// A line chart.
 #[derive(Debug, Clone)]
 pub struct Figure {
@@ -116,6 +197,7 @@ pub fn deployment_figures(
     beam_names: &[String],
 ) -> Vec<Figure> {
     let n = d.chain.len();
+    let span: f64 = d.chain.panels.iter().map(|p| p.length).sum();
     let shown: Vec<usize> = (0..n).step_by(n.div_ceil(8).max(1)).collect();
     let m = r.samples.len();
     let t = |k: usize| r.samples[k].t;
@@ -179,9 +261,11 @@ pub fn deployment_figures(
             "u, v [m]; θ [rad]",
             hub,
         ));
+        clean(&mut figs, span);
         return figs;
     }
     figs.extend(body_figures(r, beam_names, &markers));
+    clean(&mut figs, span);
     figs
 }
 
@@ -356,29 +440,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         "rotation [rad]",
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));
-    for (b, stem) in st.beams.iter().zip(&stems) {
-        let kind = ChannelKind::BeamRoot {
-            beam: b.name.clone(),
-        };
-        out.push(fig(
-            format!("response_{stem}_root_moment"),
-            format!(
-                "{} root moment (parent on beam, about its root point)",
-                b.name
-            ),
-            "moment [N·m]",
-            pick(&|c| c.kind == kind && c.unit == "N·m"),
-        ));
-    }
-    let latches = pick(&|c| matches!(c.kind, ChannelKind::LatchMoment { .. }));
-    if !latches.is_empty() {
-        out.push(fig(
-            "response_latch_moments".into(),
-            "latch moments in the deployed wing".into(),
-            "moment [N·m]",
-            latches,
-        ));
-    }
+    out.extend(load_figures(s, r, &stems));
     let modal: Vec<Curve> = r
         .modal
         .modes
@@ -401,6 +463,65 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         "η [√kg·m]",
         modal,
     ));
+    let size = st
+        .beams
+        .iter()
+        .map(|b| b.length)
+        .chain(st.plates.iter().map(|p| p.length.max(p.width)))
+        .fold(1e-3, f64::max);
+    clean(&mut out, size);
+    out
+}
+
+/// The response's load figures: every beam's root moment, and the latch moments.
+fn load_figures(s: &Scenario, r: &Response, stems: &[String]) -> Vec<Figure> {
+    let hist = &r.history;
+    let n = hist.times.len();
+    let pick = |f: &dyn Fn(&Channel) -> bool| -> Vec<Curve> {
+        r.channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| f(c))
+            .map(|(j, c)| {
+                curve(
+                    c.label.clone(),
+                    n,
+                    |k| hist.times[k],
+                    |k| hist.values[(k, j)],
+                )
+            })
+            .collect()
+    };
+    let fig = |stem: String, title: String, curves| Figure {
+        markers: Vec::new(),
+        stem,
+        title,
+        xlabel: "t after the latch [s]",
+        ylabel: "moment [N·m]",
+        curves,
+    };
+    let mut out = Vec::new();
+    for (b, stem) in s.structure.beams.iter().zip(stems) {
+        let kind = ChannelKind::BeamRoot {
+            beam: b.name.clone(),
+        };
+        out.push(fig(
+            format!("response_{stem}_root_moment"),
+            format!(
+                "{} root moment (parent on beam, about its root point)",
+                b.name
+            ),
+            pick(&|c| c.kind == kind && c.unit == "N·m"),
+        ));
+    }
+    let latches = pick(&|c| matches!(c.kind, ChannelKind::LatchMoment { .. }));
+    if !latches.is_empty() {
+        out.push(fig(
+            "response_latch_moments".into(),
+            "latch moments in the deployed wing".into(),
+            latches,
+        ));
+    }
     out
 }
 

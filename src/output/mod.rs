@@ -7,10 +7,12 @@ pub(crate) mod figures;
 mod modes;
 mod names;
 pub(crate) mod plot;
+pub(crate) mod raster;
 mod report;
 mod simulate;
 #[cfg(test)]
 mod tests;
+pub(crate) mod view3d;
 
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, write_deploy};

@@ -8,22 +8,27 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::sync::Once;
 
-/// Draws one picture into `<stem>.png` and `<stem>.svg` of the output directory: the body
-/// runs once per back end with `$root` bound to its drawing area.
+/// Draws one picture as SVG into `<stem>.svg` of the output directory and rasterises it
+/// into `<stem>.png` ([`super::raster`]): the body runs once with `$root` bound to the SVG
+/// drawing area.
 macro_rules! png_and_svg {
     ($dir:expr, $stem:expr, $size:expr, |$root:ident| $body:expr) => {{
-        for ext in ["png", "svg"] {
-            let rel = format!("{}.{ext}", $stem);
-            let path = $dir.path(&rel)?;
-            let r = if ext == "png" {
-                let $root = BitMapBackend::new(&path, $size).into_drawing_area();
-                $body
-            } else {
-                let $root = SVGBackend::new(&path, $size).into_drawing_area();
-                $body
-            };
-            r.map_err(|reason| OutputError::Plot { file: rel, reason })?;
+        let stem = $stem;
+        let mut svg = String::new();
+        {
+            let $root = SVGBackend::with_string(&mut svg, $size).into_drawing_area();
+            let r: Result<(), String> = $body;
+            r.map_err(|reason| OutputError::Plot {
+                file: format!("{stem}.svg"),
+                reason,
+            })?;
         }
+        let png = super::raster::svg_to_png(&svg).map_err(|reason| OutputError::Plot {
+            file: format!("{stem}.png"),
+            reason,
+        })?;
+        $dir.write(&format!("{stem}.svg"), svg.as_bytes())?;
+        $dir.write(&format!("{stem}.png"), png)?;
     }};
 }
 
@@ -32,8 +37,8 @@ static FONT: Once = Once::new();
 /// Registers the bundled font as "sans-serif" (once per process).
 pub fn register_font() {
     FONT.call_once(|| {
-        let bytes: &'static [u8] = include_bytes!("../../assets/DejaVuSans.ttf");
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, bytes);
+        let _ =
+            plotters::style::register_font("sans-serif", FontStyle::Normal, super::raster::FONT);
     });
 }
 
@@ -121,6 +126,8 @@ fn draw_view<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc(labels.0)
         .y_desc(labels.1)
+        .x_label_formatter(&|v| tick_label(*v, span))
+        .y_label_formatter(&|v| tick_label(*v, span))
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| e.to_string())?;
@@ -206,7 +213,7 @@ pub fn mode_shape_svg(model: &RitzModel, mode: &Mode) -> Result<String, OutputEr
 /// A named polyline for [`line_chart`].
 pub type Series = (String, Vec<(f64, f64)>);
 
-const PALETTE: [RGBColor; 8] = [
+const PALETTE: [RGBColor; 10] = [
     RGBColor(20, 90, 200),
     RGBColor(220, 60, 40),
     RGBColor(30, 150, 70),
@@ -215,25 +222,75 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(20, 160, 170),
     RGBColor(120, 120, 120),
     RGBColor(180, 40, 120),
+    RGBColor(120, 80, 30),
+    RGBColor(0, 0, 0),
 ];
 
-fn draw_chart<DB: DrawingBackend>(
-    root: DrawingArea<DB, Shift>,
-    title: &str,
-    labels: (&str, &str),
-    series: &[Series],
-    equal_aspect: bool,
-    markers: &[f64],
-) -> Result<(), String> {
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let pts = series.iter().flat_map(|s| s.1.iter());
+/// SI prefixes for the y axis: (factor, prefix).
+const PREFIXES: [(f64, &str); 8] = [
+    (1e-12, "p"),
+    (1e-9, "n"),
+    (1e-6, "µ"),
+    (1e-3, "m"),
+    (1.0, ""),
+    (1e3, "k"),
+    (1e6, "M"),
+    (1e9, "G"),
+];
+
+/// Units a prefix may go in front of.
+const PREFIXABLE: [&str; 8] = ["m", "rad", "N", "N·m", "J", "N·s", "m/s", "rad/s"];
+
+/// The factor the y values are divided by and the axis label that says so: an SI prefix on
+/// the label's unit ("deflection [µm]") when it takes one, else a shared power of ten
+/// ("η [×1e-6 √kg·m]"); the scaled values' largest magnitude lies in [1, 1000).
+pub fn axis_scale(largest: f64, label: &str) -> (f64, String) {
+    if !(largest.is_finite() && largest > 0.0) || (1e-2..1e4).contains(&largest) {
+        return (1.0, label.to_string());
+    }
+    let exp3 = (largest.log10() / 3.0).floor() as i32 * 3;
+    let factor = 10f64.powi(exp3);
+    let Some(open) = label.rfind('[') else {
+        return (factor, format!("{label} [×1e{exp3}]"));
+    };
+    let unit = label[open + 1..].trim_end_matches(']');
+    let prefix = PREFIXES
+        .iter()
+        .find(|(f, _)| (*f / factor - 1.0).abs() < 1e-9);
+    match prefix {
+        Some((_, p)) if PREFIXABLE.contains(&unit) => {
+            (factor, format!("{}[{p}{unit}]", &label[..open]))
+        }
+        _ => (factor, format!("{}[×1e{exp3} {unit}]", &label[..open])),
+    }
+}
+
+/// Tick label of v on an axis spanning `range`: as many decimals as the tick spacing (about
+/// a tenth of the range) needs, and never "-0".
+pub fn tick_label(v: f64, range: f64) -> String {
+    let step = (range / 12.0).abs().max(1e-300);
+    let decimals = (-step.log10()).ceil().clamp(0.0, 9.0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        "0".to_string()
+    } else {
+        s
+    }
+}
+
+/// The data's x and y ranges (finite points; a unit range when there are none, a padded one
+/// when flat).
+fn bounds(series: &[Series]) -> (f64, f64, f64, f64) {
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::INFINITY,
         f64::NEG_INFINITY,
     );
-    for &(x, y) in pts {
+    for &(x, y) in series.iter().flat_map(|s| s.1.iter()) {
         if x.is_finite() && y.is_finite() {
             x0 = x0.min(x);
             x1 = x1.max(x);
@@ -248,61 +305,135 @@ fn draw_chart<DB: DrawingBackend>(
         x1 = x0 + 1.0;
     }
     if y1 - y0 < 1e-12 * (y0.abs() + y1.abs()).max(1e-30) {
+        // A flat trace (identically zero, or constant): a unit span around it.
         let c = 0.5 * (y0 + y1);
-        let d = (c.abs() * 0.1).max(1e-9);
+        let d = if c == 0.0 { 1.0 } else { c.abs() * 0.1 };
         (y0, y1) = (c - d, c + d);
     }
+    (x0, x1, y0, y1)
+}
+
+/// The legend in its own area beside the plot: a line of each trace's colour and its name,
+/// and how many more traces there are when not all are listed.
+fn draw_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    named: &[(usize, &String)],
+    more: usize,
+) -> Result<(), String> {
+    let top = 40;
+    let font = || ("sans-serif", 13).into_font().color(&BLACK);
+    for (row, (i, name)) in named.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let y = top + 22 * row as i32;
+        area.draw(&PathElement::new(
+            vec![(4, y), (28, y)],
+            color.stroke_width(3),
+        ))
+        .map_err(|e| e.to_string())?;
+        area.draw(&Text::new(name.to_string(), (34, y - 8), font()))
+            .map_err(|e| e.to_string())?;
+    }
+    if more > 0 {
+        area.draw(&Text::new(
+            format!("(+{more} more)"),
+            (34, top + 22 * named.len() as i32 - 8),
+            font(),
+        ))
+        .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+fn draw_chart<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    labels: (&str, &str),
+    series: &[Series],
+    equal_aspect: bool,
+    markers: &[f64],
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let largest = series
+        .iter()
+        .flat_map(|s| s.1.iter())
+        .filter(|p| p.1.is_finite())
+        .fold(0.0_f64, |a, p| a.max(p.1.abs()));
+    let (factor, ylabel) = if equal_aspect {
+        (1.0, labels.1.to_string())
+    } else {
+        axis_scale(largest, labels.1)
+    };
+    let series: Vec<Series> = series
+        .iter()
+        .map(|(n, p)| (n.clone(), p.iter().map(|&(x, y)| (x, y / factor)).collect()))
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = bounds(&series);
+    // The legend sits beside the plot, never on the data.
+    let named: Vec<(usize, &String)> = series
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| !s.0.is_empty())
+        .map(|(i, s)| (i, &s.0))
+        .take(12)
+        .collect();
+    let (w, h) = root.dim_in_pixel();
+    let legend_w = if named.is_empty() {
+        0
+    } else {
+        let longest = named
+            .iter()
+            .map(|(_, n)| n.chars().count())
+            .max()
+            .unwrap_or(0);
+        ((longest as u32) * 7 + 44).clamp(120, w / 3)
+    };
+    let (plot_area, legend_area) = root.split_horizontally(w - legend_w);
     if equal_aspect {
-        let (w, h) = root.dim_in_pixel();
-        let span = ((x1 - x0) / w as f64).max((y1 - y0) / h as f64);
+        let pw = w - legend_w;
+        let span = ((x1 - x0) / pw as f64).max((y1 - y0) / h as f64);
         let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        (x0, x1) = (cx - 0.5 * span * w as f64, cx + 0.5 * span * w as f64);
+        (x0, x1) = (cx - 0.5 * span * pw as f64, cx + 0.5 * span * pw as f64);
         (y0, y1) = (cy - 0.5 * span * h as f64, cy + 0.5 * span * h as f64);
     }
     let pad = 0.04 * (y1 - y0);
-    let mut chart = ChartBuilder::on(&root)
+    let (ya, yb) = (y0 - pad, y1 + pad);
+    let (xr, yr) = (x1 - x0, yb - ya);
+    let mut chart = ChartBuilder::on(&plot_area)
         .caption(title, ("sans-serif", 20))
         .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))
+        .x_label_area_size(44)
+        .y_label_area_size(76)
+        .build_cartesian_2d(x0..x1, ya..yb)
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
         .x_desc(labels.0)
-        .y_desc(labels.1)
-        .label_style(("sans-serif", 13))
+        .y_desc(ylabel.as_str())
+        .x_label_formatter(&|v| tick_label(*v, xr))
+        .y_label_formatter(&|v| tick_label(*v, yr))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
         .draw()
         .map_err(|e| e.to_string())?;
-    // Event markers (latches): thin grey vertical lines across the plot.
+    // Event markers (latches, captures): thin grey vertical lines across the plot.
     for &m in markers.iter().filter(|m| (x0..=x1).contains(*m)) {
         chart
             .draw_series(LineSeries::new(
-                [(m, y0 - pad), (m, y1 + pad)],
+                [(m, ya), (m, yb)],
                 BLACK.mix(0.35).stroke_width(1),
             ))
             .map_err(|e| e.to_string())?;
     }
-    for (i, (name, pts)) in series.iter().enumerate() {
+    for (i, (_, pts)) in series.iter().enumerate() {
         let color = PALETTE[i % PALETTE.len()];
-        let drawn = chart
+        chart
             .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
             .map_err(|e| e.to_string())?;
-        if !name.is_empty() {
-            drawn.label(name.clone()).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2))
-            });
-        }
     }
-    if series.iter().any(|s| !s.0.is_empty()) && series.len() <= 12 {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .draw()
-            .map_err(|e| e.to_string())?;
-    }
+    let more = series.iter().filter(|s| !s.0.is_empty()).count() - named.len();
+    draw_legend(&legend_area, &named, more)?;
     root.present().map_err(|e| e.to_string())
 }
 

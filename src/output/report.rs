@@ -245,6 +245,25 @@ fn scenario_section(s: &Scenario) -> String {
     o
 }
 
+/// The 3-D view of the spacecraft, its deployment and its first elastic modes
+/// ([`super::view3d`], drawn by the page's script on a canvas).
+fn view_section(s: &Scenario, sim: &Simulation) -> String {
+    let spec = super::view3d::view_spec(sim, s.deployment.as_ref().map(|d| d.plate.as_str()));
+    format!(
+        "<section id=\"view3d\"><h2>3-D view</h2><div class=\"view3d\"><script type=\"application/json\">{}</script>\
+         <div class=\"controls\"><select aria-label=\"what to show\"></select> <button type=\"button\">play</button> \
+         <input type=\"range\" min=\"0\" value=\"0\" aria-label=\"time or phase\"></div>\
+         <canvas width=\"960\" height=\"560\"></canvas><p class=\"time\"></p>\
+         <p class=\"note\">Drag to rotate, wheel to zoom. Structure axes: x red, y green, z blue (bottom left); \
+         scale bar bottom right. The hub is drawn as its cylinder, or as the uniform box with its principal \
+         moments of inertia; beams as tubes of their outer diameter; plates as panels; lumped masses as spheres. \
+         Deployment: the hub moves and turns as computed, the panels unfold in the deployment plane, and the \
+         beams bend by their computed tip deflection (exaggerated by the stated factor, drawn with a \
+         cantilever's static shape). Modes: mass-normalised shapes, exaggerated by the stated factor.</p></div></section>\n",
+        embed(&spec)
+    )
+}
+
 fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
     let st = &sim.model.structure;
     let mut o = String::from("<section id=\"modes\"><h2>Modes</h2>\n");
@@ -664,11 +683,12 @@ pub fn report_html(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\
          <title>flexcraft report: {}</title><style>{STYLE}</style></head>\n<body data-status=\"loading\">\n\
          <h1>flexcraft report: {}</h1><p class=\"note\">SI units: m, kg, s, rad, N, J, Hz. Plots: hover to read values, drag to zoom a time window, double-click to reset.</p>\
-         <nav><a href=\"#scenario\">scenario</a><a href=\"#modes\">modes</a><a href=\"#deployment\">deployment</a><a href=\"#response\">response</a></nav>\n",
+         <nav><a href=\"#scenario\">scenario</a><a href=\"#view3d\">3-D view</a><a href=\"#modes\">modes</a><a href=\"#deployment\">deployment</a><a href=\"#response\">response</a></nav>\n",
         esc(&s.name),
         esc(&s.name)
     );
     o.push_str(&scenario_section(s));
+    o.push_str(&view_section(s, sim));
     o.push_str(&modes_section(sim)?);
     o.push_str(&deployment_section(s, sim));
     o.push_str(&response_section(s, sim));

@@ -317,6 +317,40 @@ fn handover_lines(o: &mut String, r: &Response) {
     );
 }
 
+/// Rounding noise in the terminal: a value at most [`super::figures::NOISE_FLOOR`] times the
+/// largest peak of its quantity among the response's channels prints as 0 (lengths and
+/// angles compared through the structure's size, as in the figures).
+fn noise_floor<'a>(s: &Scenario, r: &'a Response) -> impl Fn(f64, &str) -> f64 + 'a {
+    let st = &s.structure;
+    let size = st
+        .beams
+        .iter()
+        .map(|b| b.length)
+        .chain(st.plates.iter().map(|p| p.length.max(p.width)))
+        .fold(1e-3, f64::max);
+    let as_length = move |u: &str, v: f64| if u == "rad" { v * size } else { v };
+    let family = |u: &str| {
+        if u == "rad" {
+            "m".to_string()
+        } else {
+            u.to_string()
+        }
+    };
+    let mut reference: std::collections::BTreeMap<String, f64> = Default::default();
+    for (c, ch) in r.channels.iter().enumerate() {
+        let e = reference.entry(family(ch.unit)).or_insert(0.0);
+        *e = e.max(as_length(ch.unit, r.history.peak(c).0));
+    }
+    move |v: f64, unit: &str| {
+        let r = reference.get(&family(unit)).copied().unwrap_or(0.0);
+        if as_length(unit, v.abs()) <= super::figures::NOISE_FLOOR * r {
+            0.0
+        } else {
+            v
+        }
+    }
+}
+
 /// The response's lines of the terminal summary.
 fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) {
     let st = &s.response;
@@ -328,12 +362,14 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
         st.output_rate,
         st.damping_ratio
     );
+    let snap = noise_floor(s, r);
     for (c, ch) in r.channels.iter().enumerate() {
         if matches!(
             ch.kind,
             ChannelKind::BeamTip { .. } | ChannelKind::PlateTip { .. }
         ) {
             let (p, t) = r.history.peak(c);
+            let p = snap(p, ch.unit);
             let _ = writeln!(
                 o,
                 "  peak {:<34} {:>13.6e} {} at t = {:.3} s",
@@ -373,7 +409,7 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
             .iter()
             .enumerate()
             .filter(|(_, c)| c.kind == kind)
-            .map(|(i, _)| format!("{:.6e}", r.history.last(i)))
+            .map(|(i, c)| format!("{:.6e}", snap(r.history.last(i), c.unit)))
             .collect();
         format!("[{}]", v.join(", "))
     };

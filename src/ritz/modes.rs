@@ -98,6 +98,10 @@ pub struct ModalAnalysis {
     pub appendage_mass: [f64; 6],
 }
 
+/// Effective masses below this fraction of the appendage's mass (or inertia) in their
+/// direction are rounding noise and reported as exact zero.
+pub const EFFECTIVE_MASS_FLOOR: f64 = 1e-12;
+
 impl ModalAnalysis {
     /// Solves for every mode of the model.
     pub fn compute(model: &RitzModel) -> Result<Self, RitzError> {
@@ -111,12 +115,19 @@ impl ModalAnalysis {
         let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
 
         let (lam_f, phi_f) = generalized_symmetric(&kee, &mee)?;
+        let appendage_mass = appendage_mass(model, &mrr);
         let hub_fixed: Vec<HubFixedMode> = (0..ne)
             .map(|j| {
                 let mut eff = [0.0; 6];
                 for (d, e) in eff.iter_mut().enumerate() {
                     let l: f64 = (0..ne).map(|i| phi_f[(i, j)] * mer[(i, d)]).sum();
-                    *e = l * l;
+                    // Below EFFECTIVE_MASS_FLOOR of the appendage's mass in that direction
+                    // the value is rounding (a mode that cannot move that way): exact zero.
+                    *e = if l * l <= EFFECTIVE_MASS_FLOOR * appendage_mass[d] {
+                        0.0
+                    } else {
+                        l * l
+                    };
                 }
                 HubFixedMode {
                     omega_rad_s: lam_f[j].max(0.0).sqrt(),
@@ -124,7 +135,6 @@ impl ModalAnalysis {
                 }
             })
             .collect();
-        let appendage_mass = appendage_mass(model, &mrr);
 
         let mut modes = Vec::new();
         let motion = model.structure.hub.motion;

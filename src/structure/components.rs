@@ -30,6 +30,8 @@ pub struct Hub {
     pub(crate) mass: f64,
     pub(crate) center_of_mass: Vec3,
     pub(crate) inertia: Mat3,
+    /// The cylinder it was built from ([`Hub::cylinder`]), for drawing.
+    pub(crate) shape: Option<Cylinder>,
 }
 
 /// The paper's hub: a circular cylinder of one material, for [`Hub::cylinder`].
@@ -62,6 +64,7 @@ impl Hub {
             mass: in_range(Field::Mass, mass, L::MASS)?,
             center_of_mass: point(Field::CenterOfMass, center_of_mass)?,
             inertia,
+            shape: None,
         })
     }
 
@@ -118,7 +121,17 @@ impl Hub {
             mass: in_range(Field::Mass, body.mass, L::MASS)?,
             center_of_mass: center,
             inertia,
+            shape: Some(Cylinder {
+                axis: a,
+                center,
+                ..c
+            }),
         })
+    }
+
+    /// The cylinder the hub was built from, if it was (None: given by its mass properties).
+    pub fn shape(&self) -> Option<Cylinder> {
+        self.shape
     }
 
     /// Free or fixed.
