@@ -336,8 +336,10 @@
         }
       });
       if (f) {
-        var off = mul(dep.eb, dep.offset_b), half = mul(dep.eb, dep.width / 2);
-        var body = function (uv) { return add(add(add(c0, off), mul(dep.ea, uv[0])), mul(dep.n, uv[1])); };
+        var half = mul(dep.eb, dep.width / 2);
+        // The panels ride on the carrying beam's (exaggerated) tip deflection.
+        var shift = dep.carrier === null ? [0, 0, 0] : f.tips[dep.carrier];
+        var body = function (uv) { return add(add(add(dep.origin, shift), mul(dep.ea, uv[0])), mul(dep.n, uv[1])); };
         for (var k = 0; k + 1 < f.p.length; k++) {
           var a0 = body(f.p[k]), a1 = body(f.p[k + 1]);
           poly([sub(a0, half), sub(a1, half), add(a1, half), add(a0, half)], [60, 90, 170], "#223", cross(sub(a1, a0), dep.eb));
@@ -484,9 +486,9 @@
       // Tables: per column, no non-zero number below 1e-9 of the column's largest.
       document.querySelectorAll("table").forEach(function (tb) {
         var cols = [];
-        tb.querySelectorAll("tr").forEach(function (tr) {
-          Array.prototype.forEach.call(tr.children, function (td, c) {
-            if (td.tagName !== "TD" || !/^\s*-?[0-9.]+(e-?[0-9]+)?\s*$/.test(td.textContent)) return;
+        Array.prototype.forEach.call(tb.rows, function (tr) {
+          Array.prototype.forEach.call(tr.cells, function (td, c) {
+            if (td.tagName !== "TD" || td.querySelector("table") || !/^\s*-?[0-9.]+(e-?[0-9]+)?\s*$/.test(td.textContent)) return;
             (cols[c] = cols[c] || []).push(parseFloat(td.textContent));
           });
         });

@@ -114,6 +114,21 @@ pub fn peak_latch_moments(r: &DeploymentResult) -> Value {
     )
 }
 
+/// The scales of a latch's impulses (the largest hinge or base force, N·s, and moment,
+/// N·m·s), against which rounding noise reads as zero.
+pub(crate) fn impulse_scales(e: &crate::deploy::LatchEvent) -> (f64, f64) {
+    let mut f = e
+        .impulses
+        .iter()
+        .fold(0.0_f64, |a, (v, _)| a.max(v[0].hypot(v[1])));
+    let mut m = e.impulses.iter().fold(0.0_f64, |a, (_, v)| a.max(v.abs()));
+    if let Some((bf, bm)) = e.base_impulse {
+        f = bf.iter().fold(f, |a, v| a.max(v.abs()));
+        m = bm.iter().fold(m, |a, v| a.max(v.abs()));
+    }
+    (f, m.max(f))
+}
+
 /// "flexible, 12 of 40 modes" / "rigid", and the synchronisation's name.
 fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
     let base = match d.base {
@@ -235,20 +250,22 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
             let (f, m) = e.impulses[i];
             let _ = writeln!(
                 s,
-                "{:>6} {:>12.6} {:>13.6} {:>13.6} {:>13.6} {:>13.6} {:>13.6}",
+                "{:>6} {:>12} {:>13} {:>13} {:>13} {:>13} {:>13}",
                 i + 1,
-                e.angles[i],
-                e.rates_before[i],
-                e.rates_after[i],
-                f[0],
-                f[1],
-                m
+                super::fixed(e.angles[i], 6),
+                super::fixed(e.rates_before[i], 6),
+                super::fixed(e.rates_after[i], 6),
+                super::fixed(f[0], 6),
+                super::fixed(f[1], 6),
+                super::fixed(m, 6)
             );
         }
         if show < d.chain.len() {
             let _ = writeln!(s, "   … {} more hinges in --json", d.chain.len() - show);
         }
         if let Some((f, m)) = e.base_impulse {
+            let (fs, ms) = impulse_scales(e);
+            let (f, m) = (f.map(|v| super::snap(v, fs)), m.map(|v| super::snap(v, ms)));
             let _ = writeln!(
                 s,
                 "impulse on the base at the root hinge (hub axes): force [{:.6e}, {:.6e}, {:.6e}] N·s, moment [{:.6e}, {:.6e}, {:.6e}] N·m·s",

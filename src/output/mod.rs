@@ -28,6 +28,26 @@ fn num(v: f64) -> String {
     format!("{v:e}")
 }
 
+/// v for display: exact zero when |v| is at most [`figures::NOISE_FLOOR`] times `scale` (the
+/// largest value of that quantity), so that rounding noise reads as the zero it is.
+pub(crate) fn snap(v: f64, scale: f64) -> f64 {
+    if v.abs() <= figures::NOISE_FLOOR * scale.abs() {
+        0.0
+    } else {
+        v
+    }
+}
+
+/// v with `decimals` fixed decimals, never "-0.000…".
+pub(crate) fn fixed(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.starts_with('-') && s[1..].chars().all(|c| c == '0' || c == '.') {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
 /// Failure to write an output.
 #[derive(Debug, Error)]
 #[non_exhaustive]

@@ -358,8 +358,16 @@ fn frequency_table(sim: &Simulation, o: &mut String) {
 /// A free hub's elastic modes carry no base-excitation effective mass; the standard measure
 /// is that of the hub-fixed modes.
 fn hub_fixed_table(sim: &Simulation, o: &mut String) {
-    o.push_str("<h3>Effective masses of the hub-fixed elastic modes</h3><table id=\"effective-masses\"><tr><th>mode</th><th>f [Hz]</th><th>x [kg]</th><th>y [kg]</th><th>z [kg]</th><th>rx [kg·m²]</th><th>ry [kg·m²]</th><th>rz [kg·m²]</th></tr>\n");
-    for (i, m) in sim.modes.hub_fixed.iter().take(12).enumerate() {
+    o.push_str("<h3>Effective masses of the hub-fixed elastic modes</h3><table id=\"effective-masses\"><tr><th>mode</th><th>f [Hz]</th><th>x [kg]</th><th>y [kg]</th><th>z [kg]</th><th>rx [kg·m²]</th><th>ry [kg·m²]</th><th>rz [kg·m²]</th><th>Σ x</th><th>Σ y</th><th>Σ z</th><th>Σ rx</th><th>Σ ry</th><th>Σ rz</th></tr>\n");
+    let fractions = sim.modes.effective_mass_fractions();
+    for (i, (m, fr)) in sim
+        .modes
+        .hub_fixed
+        .iter()
+        .zip(&fractions)
+        .take(12)
+        .enumerate()
+    {
         let _ = write!(
             o,
             "<tr><td>{}</td><td>{:.6}</td>",
@@ -369,11 +377,14 @@ fn hub_fixed_table(sim: &Simulation, o: &mut String) {
         for v in m.effective_mass {
             let _ = write!(o, "<td>{v:.4e}</td>");
         }
+        for v in fr {
+            let _ = write!(o, "<td>{}</td>", super::fixed(*v, 5));
+        }
         o.push_str("</tr>\n");
     }
     let _ = writeln!(
         o,
-        "</table><p class=\"note\">Appendage rigid mass (the limit of the sums): {}.</p>",
+        "</table><p class=\"note\">Σ: the running sums as fractions of the appendage's rigid mass and inertia (the limit of the sums): {}.</p>",
         sim.modes
             .appendage_mass
             .iter()
@@ -398,48 +409,78 @@ fn mode_shapes(sim: &Simulation, o: &mut String) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Coefficient tables of the first two elastic modes, as the paper's tables 2.2–2.3.
+/// The full Ritz coefficient tables of the first six elastic modes (the paper's tables
+/// 2.2–2.3 show the first terms of two), each mode collapsible: per beam, one row per
+/// function index and a column per field (u, v, w, θ); per plate, g_mn with m down and n
+/// across. A coefficient within [`super::figures::NOISE_FLOOR`] of the mode's largest reads 0.
 fn coefficient_tables(sim: &Simulation, o: &mut String) {
     let st = &sim.model.structure;
-    o.push_str("<h3>Ritz coefficients of the first two elastic modes (as the paper's tables 2.2–2.3)</h3><p class=\"note\">Mass-normalised shapes. Beams: v_k, w_k bending in the two planes (the paper's d, f), θ_k torsion (c); plates: g_mn (m along the length, n across the width; the width functions include the two rigid ones).</p>\n");
-    for m in sim.modes.elastic().take(2) {
+    o.push_str("<h3>Ritz coefficients (as the paper's tables 2.2–2.3, every term)</h3><p class=\"note\">Mass-normalised shapes (√kg⁻¹·m per unit modal amplitude). Beams: u axial, v and w bending in the section's two planes (the paper's d, f), θ torsion (c); plates: g_mn (m along the length, n across the width; the width functions include the two rigid ones). Click a mode to open its tables.</p>\n");
+    for m in sim.modes.elastic().take(6) {
+        let big = m.shape.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let cell = |v: f64| {
+            if v.abs() <= super::figures::NOISE_FLOOR * big {
+                "<td>0</td>".to_string()
+            } else {
+                format!("<td>{v:.6e}</td>")
+            }
+        };
         let _ = write!(
             o,
-            "<table class=\"coefficients\"><tr><th class=\"l\" colspan=\"2\">mode {} (f = {:.6} Hz)</th></tr>",
+            "<details class=\"coefficients\" data-mode=\"{}\"><summary>mode {} (f = {:.6} Hz)</summary>",
+            m.number,
             m.number,
             m.frequency_hz()
         );
         for e in &sim.model.elements {
-            let name = st.component_name(e.id);
-            // (label, coordinate index) of the first two functions of each field.
-            let mut cells: Vec<(String, usize)> = Vec::new();
-            for f in &e.fields {
-                if let crate::structure::ComponentId::Plate(i) = e.id {
-                    let t = st.plates[i].terms;
-                    for mi in 0..t.length.min(2) {
-                        for ni in 0..t.width.min(2) {
-                            cells.push((
-                                format!("g_{}{}", mi + 1, ni + 1),
-                                f.start + mi * t.width + ni,
-                            ));
-                        }
-                    }
-                } else {
-                    for k in 0..f.len.min(2) {
-                        cells.push((format!("{}_{}", f.kind.name(), k + 1), f.start + k));
-                    }
-                }
+            let name = esc(st.component_name(e.id));
+            if e.fields.is_empty() {
+                continue;
             }
-            for (label, idx) in cells {
+            if let crate::structure::ComponentId::Plate(i) = e.id {
+                let t = st.plates()[i].terms();
+                let start = e.own_range().start;
                 let _ = write!(
                     o,
-                    "<tr><td class=\"l\">{} {label}</td><td>{:.6e}</td></tr>",
-                    esc(name),
-                    m.shape[idx]
+                    "<table class=\"coefficients\"><tr><th class=\"l\">{name} g_mn</th>"
                 );
+                for n in 0..t.width {
+                    let _ = write!(o, "<th>n = {}</th>", n + 1);
+                }
+                o.push_str("</tr>");
+                for mi in 0..t.length {
+                    let _ = write!(o, "<tr><th>m = {}</th>", mi + 1);
+                    for n in 0..t.width {
+                        o.push_str(&cell(m.shape[start + mi * t.width + n]));
+                    }
+                    o.push_str("</tr>");
+                }
+                o.push_str("</table>\n");
+                continue;
             }
+            let rows = e.fields.iter().map(|f| f.len).max().unwrap_or(0);
+            let _ = write!(
+                o,
+                "<table class=\"coefficients\"><tr><th class=\"l\">{name}</th>"
+            );
+            for f in &e.fields {
+                let _ = write!(o, "<th>{}_k</th>", f.kind.name());
+            }
+            o.push_str("</tr>");
+            for k in 0..rows {
+                let _ = write!(o, "<tr><th>k = {}</th>", k + 1);
+                for f in &e.fields {
+                    if k < f.len {
+                        o.push_str(&cell(m.shape[f.start + k]));
+                    } else {
+                        o.push_str("<td></td>");
+                    }
+                }
+                o.push_str("</tr>");
+            }
+            o.push_str("</table>\n");
         }
-        o.push_str("</table>\n");
+        o.push_str("</details>\n");
     }
 }
 
@@ -521,16 +562,21 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
             keyed(
                 &format!("/deployment/latches/{i}/energy_after"),
                 e.energy_after,
-                format!("{:.6e}", e.energy_after)
+                format!("{:.6e}", super::snap(e.energy_after, e.energy_before))
             ),
-            e.energy_before - e.energy_after,
-            e.base_impulse.map_or_else(String::new, |(f, m)| format!(
-                "[{:.4e}, {:.4e}, {:.4e}], [{:.4e}, {:.4e}, {:.4e}]",
-                f[0], f[1], f[2], m[0], m[1], m[2]
-            ))
+            super::snap(e.energy_before - e.energy_after, e.energy_before),
+            e.base_impulse.map_or_else(String::new, |(f, m)| {
+                let (fs, ms) = super::deploy::impulse_scales(e);
+                let (f, m) = (f.map(|v| super::snap(v, fs)), m.map(|v| super::snap(v, ms)));
+                format!(
+                    "[{:.4e}, {:.4e}, {:.4e}], [{:.4e}, {:.4e}, {:.4e}]",
+                    f[0], f[1], f[2], m[0], m[1], m[2]
+                )
+            })
         );
     }
     o.push_str("</table>\n");
+    latch_details(r, &mut o);
     for w in &r.warnings {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
@@ -546,6 +592,39 @@ fn deployment_section(s: &Scenario, sim: &Simulation) -> String {
     }
     o.push_str("</section>\n");
     o
+}
+
+/// Per latch, what the terminal shows: every hinge's angle, rates before and after and the
+/// impulse it carries (the first 12 hinges); rounding noise reads 0.
+fn latch_details(r: &crate::deploy::DeploymentResult, o: &mut String) {
+    for (i, e) in r.latches.iter().enumerate() {
+        let (fs, ms) = super::deploy::impulse_scales(e);
+        let _ = write!(
+            o,
+            "<details class=\"latch\"><summary>latch {}: hinge {} at t = {:.9} s, locks {:?}</summary>\
+             <table class=\"latch-hinges\"><tr><th>hinge</th><th>α [rad]</th><th>rate before [rad/s]</th><th>rate after [rad/s]</th>\
+             <th>S_u [N·s]</th><th>S_v [N·s]</th><th>M_S [N·m·s]</th></tr>",
+            i + 1,
+            e.hinge,
+            e.time,
+            e.locked
+        );
+        for k in 0..e.angles.len().min(12) {
+            let (f, m) = e.impulses[k];
+            let _ = write!(
+                o,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                k + 1,
+                super::fixed(e.angles[k], 6),
+                super::fixed(e.rates_before[k], 6),
+                super::fixed(e.rates_after[k], 6),
+                super::fixed(super::snap(f[0], fs), 6),
+                super::fixed(super::snap(f[1], fs), 6),
+                super::fixed(super::snap(m, ms), 6)
+            );
+        }
+        o.push_str("</table></details>\n");
+    }
 }
 
 fn response_section(s: &Scenario, sim: &Simulation) -> String {
@@ -613,11 +692,39 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
             r.history.energy_drift(),
         ),
     ];
-    for (label, key, v) in rows {
+    // Rounding noise reads 0 (the exact values stay in data-value and summary.json): energies
+    // against the largest kinetic energy of the run (the hand-over's totals included), ratios
+    // against 1, momenta against √(2 E m) of the
+    // spacecraft (and that times its size for angular momentum).
+    let energy = sim
+        .deployment
+        .samples
+        .iter()
+        .map(|x| x.kinetic)
+        .fold(h.energy_before + h.elastic_energy_before, f64::max)
+        .max(h.energy_after + h.elastic_energy_after)
+        .max(f64::MIN_POSITIVE);
+    let p_scale = (2.0 * energy * s.structure.total_mass()).sqrt();
+    let size = s
+        .structure
+        .beams()
+        .iter()
+        .map(|b| b.length())
+        .chain(s.structure.plates().iter().map(|p| p.length()))
+        .fold(1.0, f64::max);
+    let shown = |v: f64, scale: f64| {
+        if v.abs() <= super::figures::NOISE_FLOOR * scale {
+            "0".to_string()
+        } else {
+            format!("{v:.6e}")
+        }
+    };
+    for (i, (label, key, v)) in rows.into_iter().enumerate() {
+        let scale = if i < 6 { energy } else { 1.0 };
         let _ = writeln!(
             o,
             "<tr><td class=\"l\">{label}</td>{}</tr>",
-            keyed(key, v, format!("{v:.6e}"))
+            keyed(key, v, shown(v, scale))
         );
     }
     for (label, key, v) in [
@@ -644,12 +751,13 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     ] {
         let _ = write!(o, "<tr><td class=\"l\">{label}</td><td><table>");
         let _ = write!(o, "<tr>");
+        let scale = if label.starts_with("angular") {
+            p_scale * size
+        } else {
+            p_scale
+        };
         for k in 0..3 {
-            o.push_str(&keyed(
-                &format!("{key}/{k}"),
-                v.0[k],
-                format!("{:.6e}", v.0[k]),
-            ));
+            o.push_str(&keyed(&format!("{key}/{k}"), v.0[k], shown(v.0[k], scale)));
         }
         o.push_str("</tr></table></td></tr>\n");
     }

@@ -131,7 +131,9 @@ pub fn view_spec(sim: &Simulation, deploying_plate: Option<&str>) -> Value {
            "masses": masses, "modes": modes, "deploy": deploying_plate.map_or(Value::Null, |p| deploy_json(sim, p, extent))})
 }
 
-/// The deployment frames: time, the hub's r and ρ, the hinge points in the deployment plane,
+/// The deployment frames: time, the hub's r and ρ, the hinge points in the deployment plane
+/// (u along the plate's length axis, v along its normal, from the root hinge at the plate's
+/// attachment point `origin`),
 /// and every beam's tip deflection (structure axes) with the factor that makes the largest
 /// visible (10 % of the extent).
 fn deploy_json(sim: &Simulation, plate_name: &str, extent: f64) -> Value {
@@ -180,6 +182,7 @@ fn deploy_json(sim: &Simulation, plate_name: &str, extent: f64) -> Value {
         })
         .collect();
     json!({"plate": pi, "ea": p3(ea), "n": p3(n), "eb": p3(eb), "c": p3(hub_c),
-           "offset_b": r5((att - hub_c).dot(eb)), "width": r5(plate.width()),
-           "k_tip": k_tip, "tip_beams": beam_index, "frames": frames})
+           "origin": p3(att), "width": r5(plate.width()),
+           "k_tip": k_tip, "tip_beams": beam_index, "frames": frames,
+           "carrier": c.base.beams.iter().position(|b| b.carries_array)})
 }
