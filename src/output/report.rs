@@ -627,28 +627,9 @@ fn latch_details(r: &crate::deploy::DeploymentResult, o: &mut String) {
     }
 }
 
-fn response_section(s: &Scenario, sim: &Simulation) -> String {
-    let mut o = String::from("<section id=\"response\"><h2>Response</h2>\n");
-    let Some(r) = &sim.response else {
-        o.push_str(
-            "<p class=\"warn\">No response: the array did not latch completely.</p></section>\n",
-        );
-        return o;
-    };
+/// The hand-over balance: energies, the kept modes' share, the drift and the momenta.
+fn handover_table(s: &Scenario, sim: &Simulation, r: &crate::simulation::Response, o: &mut String) {
     let h = &r.handover;
-    let _ = writeln!(
-        o,
-        "<h3>Hand-over at the final latch</h3><p>t = {:.6} s (latch of hinge {}), method <b>{}</b>; {} s of response at {} Hz, ζ = {}, {} rigid + {} of {} elastic modes kept.</p>",
-        h.latch_time,
-        h.latch_hinge,
-        h.method.name(),
-        s.response.duration,
-        s.response.output_rate,
-        s.response.damping_ratio,
-        r.modal.modes.iter().filter(|m| m.rigid).count(),
-        r.modal.kept_elastic(),
-        r.modal.available_elastic
-    );
     o.push_str("<table id=\"handover\"><tr><th class=\"l\">quantity</th><th>value</th></tr>\n");
     let rows = [
         (
@@ -762,6 +743,31 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
         o.push_str("</tr></table></td></tr>\n");
     }
     o.push_str("</table>\n");
+}
+
+fn response_section(s: &Scenario, sim: &Simulation) -> String {
+    let mut o = String::from("<section id=\"response\"><h2>Response</h2>\n");
+    let Some(r) = &sim.response else {
+        o.push_str(
+            "<p class=\"warn\">No response: the array did not latch completely.</p></section>\n",
+        );
+        return o;
+    };
+    let h = &r.handover;
+    let _ = writeln!(
+        o,
+        "<h3>Hand-over at the final latch</h3><p>t = {:.6} s (latch of hinge {}), method <b>{}</b>; {} s of response at {} Hz, ζ = {}, {} rigid + {} of {} elastic modes kept.</p>",
+        h.latch_time,
+        h.latch_hinge,
+        h.method.name(),
+        s.response.duration,
+        s.response.output_rate,
+        s.response.damping_ratio,
+        r.modal.modes.iter().filter(|m| m.rigid).count(),
+        r.modal.kept_elastic(),
+        r.modal.available_elastic
+    );
+    handover_table(s, sim, r, &mut o);
     for w in &sim.warnings {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
