@@ -23,6 +23,8 @@ use std::fmt::Write;
 
 const SCRIPT: &str = include_str!("../../assets/report.js");
 const STYLE: &str = include_str!("../../assets/report.css");
+/// The frames-and-signs figure (also docs/frames.svg).
+const FRAMES: &str = include_str!("../../docs/frames.svg");
 /// Most frames in the deployment animation (every example has fewer samples than this).
 const ANIMATION_FRAMES: usize = 4000;
 
@@ -241,6 +243,11 @@ fn scenario_section(s: &Scenario) -> String {
         o.push_str("</table>\n");
     }
     o.push_str(&sketch(st));
+    let _ = write!(
+        o,
+        "<h3>Frames and signs</h3><figure class=\"frames\">{}</figure>",
+        FRAMES
+    );
     o.push_str("</section>\n");
     o
 }
