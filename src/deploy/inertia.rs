@@ -71,7 +71,7 @@ pub struct Invariants {
 }
 
 /// The η-dependent invariants at one η.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct AtShape {
     /// s(η).
     pub s: Vec3,
@@ -136,34 +136,67 @@ impl Invariants {
 
     /// s(η), J(η), L(η) and ∂J/∂η.
     pub fn at(&self, eta: &[f64]) -> AtShape {
+        let mut out = AtShape::default();
+        self.at_into(eta, &mut out);
+        out
+    }
+
+    /// [`Invariants::at`] into `out` (its vectors reused: no allocation once sized):
+    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a (J1_a η_a + Σ_b J2_ab η_a η_b),
+    ///   L_b = L₀_b + Σ_a L1_ab η_a,   ∂J/∂η_a = J1_a + Σ_b (J2_ab + J2_abᵀ) η_b.
+    /// Element by element on the 3×3 arrays (the generic `Mat3` operators go through
+    /// `array::map`, which is not inlined), in the same order of operations as the sums above.
+    pub fn at_into(&self, eta: &[f64], out: &mut AtShape) {
         let m = self.modes;
         let mut s = self.s0;
-        let mut j = self.j0;
-        let mut l = self.l0.clone();
-        let mut dj = self.j1.clone();
+        let mut j = self.j0.0;
+        out.l.clear();
+        out.l.extend_from_slice(&self.l0);
+        out.dj.clear();
+        out.dj.extend_from_slice(&self.j1);
         for a in 0..m {
-            s = s + self.s[a] * eta[a];
-            j = j + self.j1[a] * eta[a];
+            let ea = eta[a];
+            s = s + self.s[a] * ea;
+            let j1 = &self.j1[a].0;
+            for r in 0..3 {
+                for c in 0..3 {
+                    j[r][c] += j1[r][c] * ea;
+                }
+            }
+            let dja = &mut out.dj[a].0;
             for b in 0..m {
-                let jab = self.j2[a * m + b];
-                j = j + jab * (eta[a] * eta[b]);
-                dj[a] = dj[a] + (jab + jab.transpose()) * eta[b];
-                l[b] = l[b] + self.l1[a * m + b] * eta[a];
+                let jab = &self.j2[a * m + b].0;
+                let (eb, eab) = (eta[b], ea * eta[b]);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        j[r][c] += jab[r][c] * eab;
+                        dja[r][c] += (jab[r][c] + jab[c][r]) * eb;
+                    }
+                }
+                out.l[b] = out.l[b] + self.l1[a * m + b] * ea;
             }
         }
-        AtShape { s, j, l, dj }
+        out.s = s;
+        out.j = Mat3(j);
     }
 
     /// L̇ = Σ_j η̇_j L1_j, as columns.
     pub fn l_rate(&self, eta_dot: &[f64]) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        self.l_rate_into(eta_dot, &mut out);
+        out
+    }
+
+    /// [`Invariants::l_rate`] into `out` (resized to m).
+    pub fn l_rate_into(&self, eta_dot: &[f64], out: &mut Vec<Vec3>) {
         let m = self.modes;
-        let mut out = vec![Vec3::ZERO; m];
+        out.clear();
+        out.resize(m, Vec3::ZERO);
         for a in 0..m {
             for b in 0..m {
                 out[b] = out[b] + self.l1[a * m + b] * eta_dot[a];
             }
         }
-        out
     }
 
     /// S η̇.
