@@ -266,7 +266,7 @@ impl Coupled {
         self.admissible_into(free, &mut z);
         let mut out = Mat::zeros(self.speeds(), z.len());
         for j in 0..z.len() {
-            for (i, v) in z.column(j) {
+            for &(i, v) in z.column(j) {
                 out[(i, j)] = v;
             }
         }
@@ -1075,10 +1075,8 @@ impl SparseColumns {
         self.start.len().saturating_sub(1)
     }
 
-    fn column(&self, j: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        self.entries[self.start[j]..self.start[j + 1]]
-            .iter()
-            .copied()
+    fn column(&self, j: usize) -> &[(usize, f64)] {
+        &self.entries[self.start[j]..self.start[j + 1]]
     }
 }
 
@@ -1109,19 +1107,27 @@ fn solve_admissible(
         return;
     }
     // Z is sparse (unit columns for the hub and base speeds and the free hinges, one cable
-    // column): ZᵀMZ and Zᵀb by loops over its non-zeros.
+    // column): ZᵀMZ and Zᵀb by loops over its non-zeros, the lower triangle of ZᵀMZ only
+    // (the factorisation reads no more).
     refill(&mut work.zmz, k * k, 0.0);
     for a in 0..k {
-        for c in 0..k {
-            work.zmz[a * k + c] = z
-                .column(a)
-                .map(|(i, za)| za * z.column(c).map(|(j, zc)| m(i, j) * zc).sum::<f64>())
-                .sum::<f64>();
+        let col_a = z.column(a);
+        for c in 0..=a {
+            let col_c = z.column(c);
+            let mut v = 0.0;
+            for &(i, za) in col_a {
+                let mut t = 0.0;
+                for &(j, zc) in col_c {
+                    t += m(i, j) * zc;
+                }
+                v += za * t;
+            }
+            work.zmz[a * k + c] = v;
         }
     }
     refill(&mut work.w, k, 0.0);
     for (a, wa) in work.w.iter_mut().enumerate() {
-        *wa = z.column(a).map(|(j, zj)| zj * b[j]).sum::<f64>();
+        *wa = z.column(a).iter().map(|&(j, zj)| zj * b[j]).sum::<f64>();
     }
     if !cholesky_in_place(&mut work.zmz, k) {
         u.fill(f64::NAN);
@@ -1129,7 +1135,7 @@ fn solve_admissible(
     }
     cholesky_solve(&work.zmz, k, &mut work.w);
     for (j, wj) in work.w.iter().enumerate() {
-        for (i, zij) in z.column(j) {
+        for &(i, zij) in z.column(j) {
             u[i] += zij * wj;
         }
     }

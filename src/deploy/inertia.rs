@@ -141,11 +141,12 @@ impl Invariants {
         out
     }
 
-    /// [`Invariants::at`] into `out` (its vectors reused: no allocation once sized):
-    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a (J1_a η_a + Σ_b J2_ab η_a η_b),
-    ///   L_b = L₀_b + Σ_a L1_ab η_a,   ∂J/∂η_a = J1_a + Σ_b (J2_ab + J2_abᵀ) η_b.
-    /// Element by element on the 3×3 arrays (the generic `Mat3` operators go through
-    /// `array::map`, which is not inlined), in the same order of operations as the sums above.
+    /// [`Invariants::at`] into `out` (its vectors reused: no allocation once sized). With
+    /// K_a = Σ_b J2_ab η_b (J2_ba = J2_abᵀ, so Σ_b J2_abᵀ η_b = K_aᵀ):
+    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a η_a (J1_a + K_a),
+    ///   L_b = L₀_b + Σ_a L1_ab η_a,   ∂J/∂η_a = J1_a + K_a + K_aᵀ,
+    /// 9 m² multiply-adds for the quadratic terms, element by element on the 3×3 arrays (the
+    /// generic `Mat3` operators go through `array::map`, which is not inlined).
     pub fn at_into(&self, eta: &[f64], out: &mut AtShape) {
         let m = self.modes;
         let mut s = self.s0;
@@ -153,27 +154,28 @@ impl Invariants {
         out.l.clear();
         out.l.extend_from_slice(&self.l0);
         out.dj.clear();
-        out.dj.extend_from_slice(&self.j1);
         for a in 0..m {
             let ea = eta[a];
             s = s + self.s[a] * ea;
-            let j1 = &self.j1[a].0;
-            for r in 0..3 {
-                for c in 0..3 {
-                    j[r][c] += j1[r][c] * ea;
-                }
-            }
-            let dja = &mut out.dj[a].0;
-            for b in 0..m {
-                let jab = &self.j2[a * m + b].0;
-                let (eb, eab) = (eta[b], ea * eta[b]);
+            let mut k = [[0.0; 3]; 3];
+            for (jab, eb) in self.j2[a * m..(a + 1) * m].iter().zip(eta) {
                 for r in 0..3 {
                     for c in 0..3 {
-                        j[r][c] += jab[r][c] * eab;
-                        dja[r][c] += (jab[r][c] + jab[c][r]) * eb;
+                        k[r][c] += jab.0[r][c] * eb;
                     }
                 }
-                out.l[b] = out.l[b] + self.l1[a * m + b] * ea;
+            }
+            let j1 = &self.j1[a].0;
+            let mut dj = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for c in 0..3 {
+                    j[r][c] += (j1[r][c] + k[r][c]) * ea;
+                    dj[r][c] = j1[r][c] + (k[r][c] + k[c][r]);
+                }
+            }
+            out.dj.push(Mat3(dj));
+            for (lb, l1) in out.l.iter_mut().zip(&self.l1[a * m..(a + 1) * m]) {
+                *lb = *lb + *l1 * ea;
             }
         }
         out.s = s;
