@@ -72,14 +72,17 @@ fn scenario(terms: (usize, usize, usize), panels: usize, stiffness: Option<f64>)
     );
     if panels != 3 {
         src = edit(src, "panels = 3", &format!("panels = {panels}"));
-        src = edit(src, SEED_HINGES, "");
+        // Older seeds list per-hinge tables for their three hinges.
+        src = src.replace(SEED_HINGES, "");
     }
     if let Some(k) = stiffness {
-        src = edit(
-            src,
-            "[deployment.hinge]\nstiffness = 4.0",
-            &format!("[deployment.hinge]\nstiffness = {k:?}"),
-        );
+        let key = "[deployment.hinge]\nstiffness = ";
+        let at = src
+            .find(key)
+            .expect("examples/seed.toml has [deployment.hinge] stiffness")
+            + key.len();
+        let end = at + src[at..].find('\n').expect("a line");
+        src.replace_range(at..end, &format!("{k:?}"));
     }
     Scenario::from_toml_str(&src, "seed.toml").expect("scenario")
 }

@@ -35,11 +35,13 @@
 
 use super::attitude::{self, Quaternion};
 use super::base::BaseModel;
-use super::chain::Chain;
+use super::chain::{Chain, P2};
 use super::inertia::{combine, AtShape};
 use crate::math::{Mat3, Vec3};
 use crate::structure::HubMotion;
 use faer::{Mat, Side};
+use std::cell::RefCell;
+use std::f64::consts::PI;
 
 /// How the hinges are tied.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -260,45 +262,52 @@ impl Coupled {
 
     /// Basis Z of the admissible speeds for the hinges flagged free.
     pub fn admissible(&self, free: &[bool]) -> Mat<f64> {
+        let mut z = SparseColumns::default();
+        self.admissible_into(free, &mut z);
+        let mut out = Mat::zeros(self.speeds(), z.len());
+        for j in 0..z.len() {
+            for &(i, v) in z.column(j) {
+                out[(i, j)] = v;
+            }
+        }
+        out
+    }
+
+    /// Z as sparse columns: a unit column per base speed, then one per free hinge
+    /// (independent or elastically tied hinges) or, with an ideal cable and any hinge free,
+    /// the cable's column (1, 2, 2, …) over the opening rates.
+    fn admissible_into(&self, free: &[bool], z: &mut SparseColumns) {
         let (nb, n) = (self.rate_offset(), self.panels());
-        let cols: Vec<Vec<f64>> = if self.sync == Synchronisation::IdealCable {
+        z.clear();
+        for i in 0..nb {
+            z.push_column([(i, 1.0)]);
+        }
+        if self.sync == Synchronisation::IdealCable {
             if free.iter().any(|f| *f) {
-                let mut c = vec![2.0; n];
-                c[0] = 1.0;
-                vec![c]
-            } else {
-                Vec::new()
+                z.push_column((0..n).map(|i| (nb + i, if i == 0 { 1.0 } else { 2.0 })));
             }
         } else {
-            (0..n)
-                .filter(|&i| free[i])
-                .map(|i| {
-                    let mut c = vec![0.0; n];
-                    c[i] = 1.0;
-                    c
-                })
-                .collect()
-        };
-        let mut z = Mat::zeros(nb + n, nb + cols.len());
-        for i in 0..nb {
-            z[(i, i)] = 1.0;
-        }
-        for (j, c) in cols.iter().enumerate() {
-            for i in 0..n {
-                z[(nb + i, nb + j)] = c[i];
+            for i in (0..n).filter(|&i| free[i]) {
+                z.push_column([(nb + i, 1.0)]);
             }
         }
-        z
     }
 
     /// Kinematics, mass matrix, velocity terms and applied forces at a state.
     pub fn evaluate(&self, y: &[f64]) -> Eval {
+        let mut ws = Workspace::default();
+        self.assemble(y, &mut ws);
+        ws.to_eval(self)
+    }
+
+    /// [`Coupled::evaluate`] into the buffers of `ws` (no allocation once they are sized).
+    fn assemble(&self, y: &[f64], ws: &mut Workspace) {
         let s = self.view(y);
         let base = &self.base;
         let inv = &base.invariants;
         let (h, m, n) = (self.hub_dof(), self.modes(), self.panels());
         let nb = h + m;
-        let at = inv.at(s.eta);
+        inv.at_into(s.eta, &mut ws.at);
         // Hinge frame.
         let theta = combine(&base.hinge_rotations, s.eta);
         let theta_dot = combine(&base.hinge_rotations, s.eta_dot);
@@ -312,16 +321,17 @@ impl Coupled {
         let a_h = s.w.cross(p_dot) + s.w.cross(v_h);
         let wd_h = attitude::left_jacobian_rate(theta, theta_dot) + s.w.cross(omega_rel);
         let et = frame.transpose();
-        // B: base speeds → [V_H; Ω_H], hinge components.
-        let mut b = Mat::zeros(6, nb);
+        // B: base speeds → [V_H; Ω_H], hinge components (6 × nb, row-major).
+        let b = &mut ws.b;
+        refill(b, 6 * nb, 0.0);
         if h == 6 {
             let ph = cross_mat(hinge);
             for i in 0..3 {
                 for j in 0..3 {
-                    b[(i, j)] = et.get(i, j);
+                    b[i * nb + j] = et.get(i, j);
                     // −E ᵀ p̃ (ω ↦ ω × p = −p̃ ω).
-                    b[(i, 3 + j)] = -(0..3).map(|k| et.get(i, k) * ph.get(k, j)).sum::<f64>();
-                    b[(3 + i, 3 + j)] = et.get(i, j);
+                    b[i * nb + 3 + j] = -(0..3).map(|k| et.get(i, k) * ph.get(k, j)).sum::<f64>();
+                    b[(3 + i) * nb + 3 + j] = et.get(i, j);
                 }
             }
         }
@@ -329,8 +339,8 @@ impl Coupled {
             let pv = et.apply(base.hinge_shapes[k]);
             let rv = et.apply(jl.apply(base.hinge_rotations[k]));
             for i in 0..3 {
-                b[(i, h + k)] = pv.get(i);
-                b[(3 + i, h + k)] = rv.get(i);
+                b[i * nb + h + k] = pv.get(i);
+                b[(3 + i) * nb + h + k] = rv.get(i);
             }
         }
         let omega_h = et.apply(s.w + omega_rel);
@@ -346,50 +356,58 @@ impl Coupled {
                 wd.get(2),
             ]
         };
-        let chain = self.chain_blocks(s.alpha, s.alpha_dot, omega_h);
+        ws.frame = frame;
+        ws.hinge = hinge;
+        ws.a_bias = a_bias;
+        self.chain_blocks(s.alpha, s.alpha_dot, omega_h, &mut ws.chain);
         // Assemble.
         let ns = nb + n;
-        let mut mass = Mat::zeros(ns, ns);
-        let mut bias = vec![0.0; ns];
-        self.base_terms(&s, &at, &mut mass, &mut bias);
-        let mc = &chain.mc;
+        refill(&mut ws.mass, ns * ns, 0.0);
+        refill(&mut ws.bias, ns, 0.0);
+        self.base_terms(&s, ws);
+        let (b, mass, bias) = (&ws.b, &mut ws.mass, &mut ws.bias);
+        let (mc, nc) = (&ws.chain.mc, 6 + n);
         // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B, Bᵀ M₁₂, M₂₁ B, M₂₂ (loops: the
         // blocks are small, and a general product's set-up costs more than the arithmetic).
-        let mut mb = vec![0.0; (6 + n) * nb]; // M_c[:, 0..6] B, row-major (6 + n) × nb
-        for i in 0..6 + n {
+        let mb = &mut ws.mb; // M_c[:, 0..6] B, row-major (6 + n) × nb
+        refill(mb, nc * nb, 0.0);
+        for i in 0..nc {
             for j in 0..nb {
-                mb[i * nb + j] = (0..6).map(|k| mc[(i, k)] * b[(k, j)]).sum::<f64>();
+                mb[i * nb + j] = (0..6).map(|k| mc[i * nc + k] * b[k * nb + j]).sum::<f64>();
             }
         }
         for i in 0..nb {
             for j in 0..nb {
-                mass[(i, j)] += (0..6).map(|k| b[(k, i)] * mb[k * nb + j]).sum::<f64>();
+                mass[i * ns + j] += (0..6).map(|k| b[k * nb + i] * mb[k * nb + j]).sum::<f64>();
             }
             for c in 0..n {
                 // Bᵀ M₁₂ = (M₂₁ B)ᵀ.
                 let v = mb[(6 + c) * nb + i];
-                mass[(i, nb + c)] += v;
-                mass[(nb + c, i)] += v;
+                mass[i * ns + nb + c] += v;
+                mass[(nb + c) * ns + i] += v;
             }
         }
         for r in 0..n {
             for c in 0..n {
-                mass[(nb + r, nb + c)] += mc[(6 + r, 6 + c)];
+                mass[(nb + r) * ns + nb + c] += mc[(6 + r) * nc + 6 + c];
             }
         }
         // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ.
-        let mut cb = chain.bc.clone();
-        for i in 0..6 + n {
-            cb[i] += (0..6).map(|k| mc[(i, k)] * a_bias[k]).sum::<f64>();
+        let cb = &mut ws.cb;
+        cb.clear();
+        cb.extend_from_slice(&ws.chain.bc);
+        for i in 0..nc {
+            cb[i] += (0..6).map(|k| mc[i * nc + k] * a_bias[k]).sum::<f64>();
         }
         for j in 0..nb {
-            bias[j] += (0..6).map(|i| b[(i, j)] * cb[i]).sum::<f64>();
+            bias[j] += (0..6).map(|i| b[i * nb + j] * cb[i]).sum::<f64>();
         }
         for c in 0..n {
             bias[nb + c] += cb[6 + c];
         }
         // Applied forces.
-        let mut force = vec![0.0; ns];
+        let force = &mut ws.force;
+        refill(force, ns, 0.0);
         for k in 0..m {
             force[h + k] = -base.omega[k].powi(2) * s.eta[k];
         }
@@ -397,49 +415,41 @@ impl Coupled {
             force[nb + i] = hg.moment(s.alpha[i], s.alpha_dot[i]);
         }
         if let Synchronisation::ElasticCable(kc) = self.sync {
-            for (row, mis) in self.cable_rows().iter().zip(self.cable_mismatch(s.alpha)) {
-                for i in 0..n {
-                    force[nb + i] -= kc * mis * row[i];
-                }
+            // Row k of C has −2 (k = 1) or −1 at hinge k − 1 and 1 at hinge k.
+            for k in 1..n {
+                let mis = self.cable_loop_mismatch(s.alpha, k);
+                let (below, at) = (if k == 1 { -2.0 } else { -1.0 }, 1.0);
+                force[nb + k - 1] -= kc * mis * below;
+                force[nb + k] -= kc * mis * at;
             }
-        }
-        Eval {
-            mass,
-            bias,
-            force,
-            at,
-            frame,
-            hinge,
-            b,
-            a_bias,
-            mc: chain.mc,
-            bc: chain.bc,
-            centres: chain.centres,
-            hinge_points: chain.hinges,
-            phi: chain.phi,
         }
     }
 
     /// C (α − α(0)) per cable loop, rad.
     pub fn cable_mismatch(&self, alpha: &[f64]) -> Vec<f64> {
-        let d: Vec<f64> = alpha
-            .iter()
-            .zip(&self.chain.hinges)
-            .map(|(a, h)| a - h.initial_angle)
-            .collect();
-        self.cable_rows()
-            .iter()
-            .map(|r| r.iter().zip(&d).map(|(c, x)| c * x).sum())
+        (1..self.panels())
+            .map(|k| self.cable_loop_mismatch(alpha, k))
             .collect()
     }
 
-    /// The base's own mass matrix and velocity terms over [v, ω, η̇] (see [`super::inertia`]).
-    fn base_terms(&self, s: &View<'_>, at: &AtShape, mass: &mut Mat<f64>, bias: &mut [f64]) {
+    /// Loop k's (k = 1 … N − 1) mismatch: (α_k − α_k(0)) − c (α_{k−1} − α_{k−1}(0)), c = 2
+    /// for the first loop, 1 for the others (hinges 0-based).
+    fn cable_loop_mismatch(&self, alpha: &[f64], k: usize) -> f64 {
+        let d = |i: usize| alpha[i] - self.chain.hinges[i].initial_angle;
+        let below = if k == 1 { -2.0 } else { -1.0 };
+        below * d(k - 1) + d(k)
+    }
+
+    /// The base's own mass matrix and velocity terms over [v, ω, η̇] (see [`super::inertia`]),
+    /// added to `ws.mass` and `ws.bias` (`ws.at` holds the invariants at η).
+    fn base_terms(&self, s: &View<'_>, ws: &mut Workspace) {
         let inv = &self.base.invariants;
         let (h, m) = (self.hub_dof(), self.modes());
+        let ns = self.speeds();
+        let (at, mass, bias) = (&ws.at, &mut ws.mass, &mut ws.bias);
         for a in 0..m {
             for c in 0..m {
-                mass[(h + a, h + c)] += inv.mee[(a, c)];
+                mass[(h + a) * ns + h + c] += inv.mee[(a, c)];
             }
         }
         if h == 0 {
@@ -447,33 +457,39 @@ impl Coupled {
         }
         let st = at.s.skew();
         for i in 0..3 {
-            mass[(i, i)] += inv.mass;
+            mass[i * ns + i] += inv.mass;
             for j in 0..3 {
-                mass[(i, 3 + j)] -= st.get(i, j);
-                mass[(3 + i, j)] += st.get(i, j);
-                mass[(3 + i, 3 + j)] += at.j.get(i, j);
+                mass[i * ns + 3 + j] -= st.get(i, j);
+                mass[(3 + i) * ns + j] += st.get(i, j);
+                mass[(3 + i) * ns + 3 + j] += at.j.get(i, j);
             }
         }
         for k in 0..m {
             for i in 0..3 {
-                mass[(i, 6 + k)] += inv.s[k].get(i);
-                mass[(6 + k, i)] += inv.s[k].get(i);
-                mass[(3 + i, 6 + k)] += at.l[k].get(i);
-                mass[(6 + k, 3 + i)] += at.l[k].get(i);
+                mass[i * ns + 6 + k] += inv.s[k].get(i);
+                mass[(6 + k) * ns + i] += inv.s[k].get(i);
+                mass[(3 + i) * ns + 6 + k] += at.l[k].get(i);
+                mass[(6 + k) * ns + 3 + i] += at.l[k].get(i);
             }
         }
         let (v, w) = (s.v, s.w);
         let (p, hh) = inv.momenta(at, v, w, s.eta_dot);
         let s_dot = inv.s_rate(s.eta_dot);
-        let j_dot = at
-            .dj
-            .iter()
-            .zip(s.eta_dot)
-            .fold(Mat3::ZERO, |acc, (d, e)| acc + *d * *e);
-        let l_dot = inv.l_rate(s.eta_dot);
+        // J̇ ω = Σ_k η̇_k (∂J/∂η_k) ω.
+        let mut j_dot = [[0.0; 3]; 3];
+        for (d, e) in at.dj.iter().zip(s.eta_dot) {
+            for r in 0..3 {
+                for c in 0..3 {
+                    j_dot[r][c] += d.0[r][c] * *e;
+                }
+            }
+        }
+        let j_dot = Mat3(j_dot);
+        inv.l_rate_into(s.eta_dot, &mut ws.l_dot);
+        let l_dot = &ws.l_dot;
         let cv = w.cross(s_dot) + w.cross(p);
         let cw =
-            s_dot.cross(v) + j_dot.apply(w) + combine(&l_dot, s.eta_dot) + w.cross(hh) + v.cross(p);
+            s_dot.cross(v) + j_dot.apply(w) + combine(l_dot, s.eta_dot) + w.cross(hh) + v.cross(p);
         for i in 0..3 {
             bias[i] += cv.get(i);
             bias[3 + i] += cw.get(i);
@@ -489,34 +505,33 @@ impl Coupled {
     }
 
     /// The chain's block matrix M_c over [A; Ω̇; α̈] and its bias b_c for H's angular
-    /// velocity `omega` (hinge components), all in hinge components.
-    fn chain_blocks(&self, alpha: &[f64], alpha_dot: &[f64], omega: Vec3) -> ChainBlocks {
+    /// velocity `omega` (hinge components), all in hinge components, into `cw`.
+    fn chain_blocks(&self, alpha: &[f64], alpha_dot: &[f64], omega: Vec3, cw: &mut ChainWork) {
         let ch = &self.chain;
         let n = ch.len();
-        let cfg = ch.configuration(alpha);
-        let rates = ch.phi_rates(alpha_dot);
+        cw.configure(ch, alpha, alpha_dot);
         let z = Vec3::new(0.0, 0.0, 1.0);
-        let p3 = |p: [f64; 2]| Vec3::new(p[0], p[1], 0.0);
-        let centres: Vec<Vec3> = cfg.centres.iter().map(|c| p3(*c)).collect();
-        let hinges: Vec<Vec3> = cfg.hinges.iter().map(|c| p3(*c)).collect();
         let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
+        let (centres, hinges, rates) = (&cw.centres, &cw.hinges, &cw.rates);
         // Panel inertia tensors in hinge components, relative velocities and accelerations.
-        let mut inertia = Vec::with_capacity(n);
-        let mut cdot = Vec::with_capacity(n);
-        let mut cdd = Vec::with_capacity(n);
+        cw.inertia.clear();
+        cw.cdot.clear();
+        cw.cdd.clear();
         let (mut vh, mut ah) = (Vec3::ZERO, Vec3::ZERO);
         for i in 0..n {
-            inertia.push(self.panel_tensor(i, cfg.phi[i]));
+            cw.inertia.push(self.panel_tensor(i, cw.phi[i]));
             let r = centres[i] - hinges[i];
             let l = hinges[i + 1] - hinges[i];
             let wi = rates[i];
-            cdot.push(vh + z.cross(r) * wi);
-            cdd.push(ah - r * (wi * wi));
+            cw.cdot.push(vh + z.cross(r) * wi);
+            cw.cdd.push(ah - r * (wi * wi));
             vh = vh + z.cross(l) * wi;
             ah = ah - l * (wi * wi);
         }
-        let mut mc = Mat::zeros(6 + n, 6 + n);
-        let mut bc = vec![0.0; 6 + n];
+        let nc = 6 + n;
+        let (mc, bc) = (&mut cw.mc, &mut cw.bc);
+        refill(mc, nc * nc, 0.0);
+        refill(bc, nc, 0.0);
         // Outboard sums, tip to root: mass, first moment, rotational inertia about ẑ and the
         // bias forces' resultant and moment about H.
         let (mut mt, mut s1) = (0.0, Vec3::ZERO);
@@ -528,12 +543,13 @@ impl Coupled {
             let p = &ch.panels[i];
             let c = centres[i];
             let wv = omega + z * rates[i];
-            let ab = omega.cross(omega.cross(c)) + omega.cross(cdot[i]) * 2.0 + cdd[i];
+            let ab = omega.cross(omega.cross(c)) + omega.cross(cw.cdot[i]) * 2.0 + cw.cdd[i];
             let eb = omega.cross(z * rates[i]);
-            let rot = inertia[i].apply(eb) + wv.cross(inertia[i].apply(wv));
+            let ii = cw.inertia[i];
+            let rot = ii.apply(eb) + wv.cross(ii.apply(wv));
             mt += p.mass;
             s1 = s1 + c * p.mass;
-            jc = jc + (Mat3::IDENTITY * c.dot(c) - c.outer(c)) * p.mass + inertia[i];
+            jc = jc + (Mat3::IDENTITY * c.dot(c) - c.outer(c)) * p.mass + ii;
             fb = fb + ab * p.mass;
             mb = mb + c.cross(ab * p.mass) + rot;
             iz += self.panel_inertia[i][2];
@@ -546,38 +562,26 @@ impl Coupled {
             let fcol = z.cross(bl) * dl;
             let mcol = z * (dl * (al + hl.dot(bl)));
             for r in 0..3 {
-                mc[(r, 6 + i)] = fcol.get(r);
-                mc[(6 + i, r)] = fcol.get(r);
-                mc[(3 + r, 6 + i)] = mcol.get(r);
-                mc[(6 + i, 3 + r)] = mcol.get(r);
+                mc[r * nc + 6 + i] = fcol.get(r);
+                mc[(6 + i) * nc + r] = fcol.get(r);
+                mc[(3 + r) * nc + 6 + i] = mcol.get(r);
+                mc[(6 + i) * nc + 3 + r] = mcol.get(r);
             }
             // d_l ẑ·[Σ (c_j − h_l) × m_j a_j^b + rot_j] = d_l ẑ·(mb − h_l × fb).
             bc[6 + i] = dl * z.dot(mb - hl.cross(fb));
         }
         let st = s1.skew();
         for r in 0..3 {
-            mc[(r, r)] = mt;
+            mc[r * nc + r] = mt;
             for c in 0..3 {
-                mc[(r, 3 + c)] = -st.get(r, c);
-                mc[(3 + r, c)] = st.get(r, c);
-                mc[(3 + r, 3 + c)] = jc.get(r, c);
+                mc[r * nc + 3 + c] = -st.get(r, c);
+                mc[(3 + r) * nc + c] = st.get(r, c);
+                mc[(3 + r) * nc + 3 + c] = jc.get(r, c);
             }
             bc[r] = fb.get(r);
             bc[3 + r] = mb.get(r);
         }
-        let maa = ch.mass_matrix(alpha);
-        for i in 0..n {
-            for j in 0..n {
-                mc[(6 + i, 6 + j)] = maa[(i, j)];
-            }
-        }
-        ChainBlocks {
-            mc,
-            bc,
-            centres,
-            hinges,
-            phi: cfg.phi,
-        }
+        cw.chain_mass(ch);
     }
 
     /// Panel i's inertia tensor about its centre in hinge components, at absolute angle φ_i.
@@ -605,12 +609,19 @@ impl Coupled {
 
     /// [`Coupled::evaluate`] with the latch moments of the captured hinges in the forces.
     fn evaluate_captured(&self, y: &[f64], captured: &[bool]) -> Eval {
-        let mut ev = self.evaluate(y);
+        let mut ws = Workspace::default();
+        self.assemble_captured(y, captured, &mut ws);
+        ws.to_eval(self)
+    }
+
+    /// [`Coupled::assemble`] with the latch moments of the captured hinges in the forces.
+    fn assemble_captured(&self, y: &[f64], captured: &[bool], ws: &mut Workspace) {
+        self.assemble(y, ws);
         let nb = self.rate_offset();
-        for (j, m) in self.latch_moments(y, captured).into_iter().enumerate() {
-            ev.force[nb + j] += m;
+        let s = self.view(y);
+        for j in 0..self.panels() {
+            ws.force[nb + j] += self.latch_moment(&s, captured, j);
         }
-        ev
     }
 
     /// The compliant latches' moments on the hinges, −k_j (α_j − α_j^L) − c_j α̇_j for the
@@ -618,14 +629,19 @@ impl Coupled {
     pub fn latch_moments(&self, y: &[f64], captured: &[bool]) -> Vec<f64> {
         let s = self.view(y);
         (0..self.panels())
-            .map(|j| match &self.latch {
-                Some(l) if captured.get(j).copied().unwrap_or(false) => {
-                    let a = s.alpha[j] - self.chain.hinges[j].latch_angle;
-                    -l.stiffness[j] * a - l.damping[j] * s.alpha_dot[j]
-                }
-                _ => 0.0,
-            })
+            .map(|j| self.latch_moment(&s, captured, j))
             .collect()
+    }
+
+    /// Hinge j's term of [`Coupled::latch_moments`].
+    fn latch_moment(&self, s: &View<'_>, captured: &[bool], j: usize) -> f64 {
+        match &self.latch {
+            Some(l) if captured.get(j).copied().unwrap_or(false) => {
+                let a = s.alpha[j] - self.chain.hinges[j].latch_angle;
+                -l.stiffness[j] * a - l.damping[j] * s.alpha_dot[j]
+            }
+            _ => 0.0,
+        }
     }
 
     /// Elastic energy of the captured latches' springs, ½ Σ k_j (α_j − α_j^L)², J.
@@ -643,9 +659,12 @@ impl Coupled {
 
     /// u̇ on the admissible speeds of the hinges flagged free: (ZᵀMZ) ẇ = Zᵀ(Q − c), u̇ = Z ẇ.
     fn accelerations(&self, ev: &Eval, free: &[bool]) -> Vec<f64> {
-        let z = self.admissible(free);
+        let mut sw = SolveWork::default();
+        self.admissible_into(free, &mut sw.z);
         let rhs: Vec<f64> = ev.force.iter().zip(&ev.bias).map(|(f, c)| f - c).collect();
-        solve_admissible(&ev.mass, &z, &rhs)
+        let mut udot = vec![0.0; rhs.len()];
+        solve_admissible(|i, j| ev.mass[(i, j)], &rhs, &mut sw, &mut udot);
+        udot
     }
 
     /// The root wrench and cable torques for accelerations u̇.
@@ -702,8 +721,11 @@ impl Coupled {
         let np = self.positions();
         let u = &y[np..];
         let mu = mat_vec(&ev.mass, u);
-        let z = self.admissible(free_after);
-        solve_admissible(&ev.mass, &z, &mu)
+        let mut sw = SolveWork::default();
+        self.admissible_into(free_after, &mut sw.z);
+        let mut out = vec![0.0; mu.len()];
+        solve_admissible(|i, j| ev.mass[(i, j)], &mu, &mut sw, &mut out);
+        out
     }
 
     /// Kinetic energy ½ uᵀ M u, J.
@@ -813,10 +835,21 @@ impl Coupled {
 
     /// dy/dt for the hinges flagged free, the compliant latches of those flagged `captured`
     /// acting.
+    /// Evaluates into a workspace kept per thread: no allocation once it is sized.
     pub fn rhs_captured(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
-        let udot = self.accelerations(&self.evaluate_captured(y, captured), free);
-        let s = self.view(y);
         let np = self.positions();
+        WORKSPACE.with_borrow_mut(|(ws, sw)| {
+            self.assemble_captured(y, captured, ws);
+            self.admissible_into(free, &mut sw.z);
+            // Q − c, in place of Q.
+            for (f, c) in ws.force.iter_mut().zip(&ws.bias) {
+                *f -= c;
+            }
+            let ns = self.speeds();
+            let mass = &ws.mass;
+            solve_admissible(|i, j| mass[i * ns + j], &ws.force, sw, &mut dy[np..]);
+        });
+        let s = self.view(y);
         let (h, m) = (self.hub_dof(), self.modes());
         if h == 6 {
             let a = attitude::matrix(s.quat);
@@ -830,8 +863,12 @@ impl Coupled {
         for (i, r) in s.alpha_dot.iter().enumerate() {
             dy[pe + m + i] = *r;
         }
-        dy[np..].copy_from_slice(&udot);
     }
+}
+
+thread_local! {
+    /// [`Coupled::rhs_captured`]'s buffers (resized whenever the model changes).
+    static WORKSPACE: RefCell<(Workspace, SolveWork)> = RefCell::new(Default::default());
 }
 
 #[derive(Default)]
@@ -842,12 +879,166 @@ struct PanelMomenta {
     mass: f64,
 }
 
-struct ChainBlocks {
-    mc: Mat<f64>,
-    bc: Vec<f64>,
+/// Clears `v` and fills it with `n` copies of `x` (keeps its allocation).
+fn refill<T: Clone>(v: &mut Vec<T>, n: usize, x: T) {
+    v.clear();
+    v.resize(n, x);
+}
+
+/// The buffers of one evaluation ([`Coupled::evaluate`]'s quantities), reused from call to
+/// call: once sized for a model, an evaluation allocates nothing. Matrices are flat and
+/// row-major.
+#[derive(Debug, Default)]
+struct Workspace {
+    /// Base invariants at η.
+    at: AtShape,
+    /// L̇ as columns.
+    l_dot: Vec<Vec3>,
+    /// Hinge frame axes (hub components) and hinge point.
+    frame: Mat3,
+    hinge: Vec3,
+    /// B (6 × nb).
+    b: Vec<f64>,
+    /// [A; Ω̇] of H for zero accelerations.
+    a_bias: [f64; 6],
+    /// The chain's blocks.
+    chain: ChainWork,
+    /// M (ns × ns), c and Q.
+    mass: Vec<f64>,
+    bias: Vec<f64>,
+    force: Vec<f64>,
+    /// M_c[:, 0..6] B ((6 + N) × nb) and b_c + M_c [a_b; 0].
+    mb: Vec<f64>,
+    cb: Vec<f64>,
+}
+
+impl Workspace {
+    /// The evaluation as an [`Eval`].
+    fn to_eval(&self, c: &Coupled) -> Eval {
+        let (ns, nb, nc) = (c.speeds(), c.rate_offset(), 6 + c.panels());
+        let cw = &self.chain;
+        Eval {
+            mass: Mat::from_fn(ns, ns, |i, j| self.mass[i * ns + j]),
+            bias: self.bias.clone(),
+            force: self.force.clone(),
+            at: self.at.clone(),
+            frame: self.frame,
+            hinge: self.hinge,
+            b: Mat::from_fn(6, nb, |i, j| self.b[i * nb + j]),
+            a_bias: self.a_bias,
+            mc: Mat::from_fn(nc, nc, |i, j| cw.mc[i * nc + j]),
+            bc: cw.bc.clone(),
+            centres: cw.centres.clone(),
+            hinge_points: cw.hinges.clone(),
+            phi: cw.phi.clone(),
+        }
+    }
+}
+
+/// The chain's quantities at one state (hinge plane, hinge components).
+#[derive(Debug, Default)]
+struct ChainWork {
+    /// Panel angles φ_i and rates φ̇_i.
+    phi: Vec<f64>,
+    rates: Vec<f64>,
+    /// Panel centres and hinge points (N + 1, the tip last).
     centres: Vec<Vec3>,
     hinges: Vec<Vec3>,
-    phi: Vec<f64>,
+    /// Panel inertia tensors, centre velocities and accelerations relative to H.
+    inertia: Vec<Mat3>,
+    cdot: Vec<Vec3>,
+    cdd: Vec<Vec3>,
+    /// M_c ((6 + N)²) and b_c.
+    mc: Vec<f64>,
+    bc: Vec<f64>,
+    /// Outboard sums of the hinges (see [`ChainWork::chain_mass`]).
+    s0: Vec<f64>,
+    bsum: Vec<P2>,
+    asum: Vec<f64>,
+}
+
+impl ChainWork {
+    /// Panel angles, centres, hinge points and angle rates: [`Chain::configuration`] and
+    /// [`Chain::phi_rates`] for the held hub of the coupled chain, in the same arithmetic,
+    /// without allocating.
+    fn configure(&mut self, ch: &Chain, alpha: &[f64], alpha_dot: &[f64]) {
+        debug_assert_eq!(ch.hub_dof(), 0);
+        let theta: f64 = 0.0;
+        let (s, c) = theta.sin_cos();
+        let r = [
+            c * ch.root[0] - s * ch.root[1],
+            s * ch.root[0] + c * ch.root[1],
+        ];
+        let mut hp = [0.0 + r[0], 0.0 + r[1]];
+        self.phi.clear();
+        self.centres.clear();
+        self.hinges.clear();
+        self.rates.clear();
+        self.hinges.push(Vec3::new(hp[0], hp[1], 0.0));
+        let mut w = 0.0;
+        for (i, p) in ch.panels.iter().enumerate() {
+            let a = alpha[i];
+            let f = if i == 0 {
+                theta + PI / 2.0 - a
+            } else {
+                let s_i = if i % 2 == 1 { -1.0 } else { 1.0 };
+                self.phi[i - 1] + s_i * (PI - a)
+            };
+            self.phi.push(f);
+            let ev = [f.cos(), f.sin()];
+            self.centres.push(Vec3::new(
+                hp[0] + 0.5 * p.length * ev[0],
+                hp[1] + 0.5 * p.length * ev[1],
+                0.0,
+            ));
+            hp = [hp[0] + p.length * ev[0], hp[1] + p.length * ev[1]];
+            self.hinges.push(Vec3::new(hp[0], hp[1], 0.0));
+            let d = if i % 2 == 0 { -1.0 } else { 1.0 };
+            w += d * alpha_dot[i];
+            self.rates.push(w);
+        }
+    }
+
+    /// The chain's mass matrix over α̈ into M_c's lower right block: [`Chain::mass_matrix`]
+    /// for the held hub, in the same arithmetic. With the outboard sums about hinge l,
+    /// S0_l = Σ_{i≥l} m_i, B_l = Σ m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i (tip to root
+    /// by the parallel-axis shift), for k ≤ l
+    ///   M_{α_k α_l} = d_k d_l [A_l + (H_l − H_k)·B_l].
+    fn chain_mass(&mut self, ch: &Chain) {
+        let nn = ch.len();
+        let nc = 6 + nn;
+        let p2 = |v: Vec3| [v.get(0), v.get(1)];
+        let sub = |a: P2, b: P2| [a[0] - b[0], a[1] - b[1]];
+        let dot = |a: P2, b: P2| a[0] * b[0] + a[1] * b[1];
+        let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
+        refill(&mut self.s0, nn, 0.0);
+        refill(&mut self.bsum, nn, [0.0; 2]);
+        refill(&mut self.asum, nn, 0.0);
+        let (mut s0n, mut bn, mut an) = (0.0, [0.0; 2], 0.0);
+        for l in (0..nn).rev() {
+            let p = &ch.panels[l];
+            let dl = sub(p2(self.hinges[l + 1]), p2(self.hinges[l]));
+            let c = sub(p2(self.centres[l]), p2(self.hinges[l]));
+            an += 2.0 * dot(dl, bn) + s0n * dot(dl, dl) + p.mass * dot(c, c) + p.inertia;
+            bn = [
+                bn[0] + s0n * dl[0] + p.mass * c[0],
+                bn[1] + s0n * dl[1] + p.mass * c[1],
+            ];
+            s0n += p.mass;
+            self.s0[l] = s0n;
+            self.bsum[l] = bn;
+            self.asum[l] = an;
+        }
+        for l in 0..nn {
+            let hl = p2(self.hinges[l]);
+            for k in 0..=l {
+                let v =
+                    d(k) * d(l) * (self.asum[l] + dot(sub(hl, p2(self.hinges[k])), self.bsum[l]));
+                self.mc[(6 + k) * nc + 6 + l] = v;
+                self.mc[(6 + l) * nc + 6 + k] = v;
+            }
+        }
+    }
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
@@ -860,42 +1051,150 @@ fn mat_vec(m: &Mat<f64>, x: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// u = Z (ZᵀMZ)⁻¹ Zᵀ b. M is positive definite for positive masses; a failed factorisation
-/// (a non-finite state) gives NaN, which stops the run.
-fn solve_admissible(m: &Mat<f64>, z: &Mat<f64>, b: &[f64]) -> Vec<f64> {
-    let n = m.nrows();
-    let k = z.ncols();
+/// A matrix's columns as lists of (row, value), in one flat buffer.
+#[derive(Debug, Default)]
+struct SparseColumns {
+    /// Start of column j in `entries` (and the end of the last column).
+    start: Vec<usize>,
+    entries: Vec<(usize, f64)>,
+}
+
+impl SparseColumns {
+    fn clear(&mut self) {
+        self.start.clear();
+        self.start.push(0);
+        self.entries.clear();
+    }
+
+    fn push_column(&mut self, col: impl IntoIterator<Item = (usize, f64)>) {
+        self.entries.extend(col);
+        self.start.push(self.entries.len());
+    }
+
+    fn len(&self) -> usize {
+        self.start.len().saturating_sub(1)
+    }
+
+    fn column(&self, j: usize) -> &[(usize, f64)] {
+        &self.entries[self.start[j]..self.start[j + 1]]
+    }
+}
+
+/// The admissible basis and the reduced system's buffers.
+#[derive(Debug, Default)]
+struct SolveWork {
+    /// Z.
+    z: SparseColumns,
+    /// ZᵀMZ (k × k, row-major), overwritten by its Cholesky factor.
+    zmz: Vec<f64>,
+    /// Zᵀb, overwritten by ẇ.
+    w: Vec<f64>,
+}
+
+/// u = Z (ZᵀMZ)⁻¹ Zᵀ b into `u`, with M given by its entries `m(i, j)` and Z in `work.z`.
+/// M is positive definite for positive masses; a failed factorisation (a non-finite state)
+/// gives NaN, which stops the run.
+fn solve_admissible(
+    m: impl Fn(usize, usize) -> f64,
+    b: &[f64],
+    work: &mut SolveWork,
+    u: &mut [f64],
+) {
+    let z = &work.z;
+    let k = z.len();
+    u.fill(0.0);
     if k == 0 {
-        return vec![0.0; n];
+        return;
     }
     // Z is sparse (unit columns for the hub and base speeds and the free hinges, one cable
-    // column): ZᵀMZ by loops over its non-zeros.
-    let nz: Vec<Vec<(usize, f64)>> = (0..k)
-        .map(|c| {
-            (0..n)
-                .filter(|&r| z[(r, c)] != 0.0)
-                .map(|r| (r, z[(r, c)]))
-                .collect()
-        })
-        .collect();
-    let zmz = Mat::from_fn(k, k, |a, c| {
-        nz[a]
-            .iter()
-            .map(|&(i, za)| za * nz[c].iter().map(|&(j, zc)| m[(i, j)] * zc).sum::<f64>())
-            .sum::<f64>()
-    });
-    let mut rhs = Mat::from_fn(k, 1, |i, _| {
-        nz[i].iter().map(|&(j, zj)| zj * b[j]).sum::<f64>()
-    });
-    match zmz.llt(Side::Lower) {
-        Ok(llt) => {
-            faer::linalg::solvers::Solve::solve_in_place(&llt, rhs.as_mut());
-            (0..n)
-                .map(|i| (0..k).map(|j| z[(i, j)] * rhs[(j, 0)]).sum())
-                .collect()
+    // column): ZᵀMZ and Zᵀb by loops over its non-zeros, the lower triangle of ZᵀMZ only
+    // (the factorisation reads no more).
+    refill(&mut work.zmz, k * k, 0.0);
+    for a in 0..k {
+        let col_a = z.column(a);
+        for c in 0..=a {
+            let col_c = z.column(c);
+            let mut v = 0.0;
+            for &(i, za) in col_a {
+                let mut t = 0.0;
+                for &(j, zc) in col_c {
+                    t += m(i, j) * zc;
+                }
+                v += za * t;
+            }
+            work.zmz[a * k + c] = v;
         }
-        Err(_) => vec![f64::NAN; n],
     }
+    refill(&mut work.w, k, 0.0);
+    for (a, wa) in work.w.iter_mut().enumerate() {
+        *wa = z.column(a).iter().map(|&(j, zj)| zj * b[j]).sum::<f64>();
+    }
+    if !cholesky_in_place(&mut work.zmz, k) {
+        u.fill(f64::NAN);
+        return;
+    }
+    cholesky_solve(&work.zmz, k, &mut work.w);
+    for (j, wj) in work.w.iter().enumerate() {
+        for &(i, zij) in z.column(j) {
+            u[i] += zij * wj;
+        }
+    }
+}
+
+/// Cholesky factorisation A = L Lᵀ of the symmetric positive definite k × k matrix `a`
+/// (row-major; the lower triangle is read), L written over the lower triangle:
+///   L_jj = √(A_jj − Σ_{p<j} L_jp²),   L_ij = (A_ij − Σ_{p<j} L_ip L_jp) / L_jj  (i > j).
+/// False if a pivot is not positive (or not finite). Hand-written: the systems are small
+/// (tens of speeds), where a library's blocking and dispatch cost more than the arithmetic.
+fn cholesky_in_place(a: &mut [f64], k: usize) -> bool {
+    for j in 0..k {
+        let row_j = &a[j * k..j * k + j];
+        let d = a[j * k + j] - dot4(row_j, row_j);
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        let ljj = d.sqrt();
+        a[j * k + j] = ljj;
+        for i in j + 1..k {
+            let (upper, lower) = a.split_at_mut(i * k);
+            let s = dot4(&lower[..j], &upper[j * k..j * k + j]);
+            lower[j] = (lower[j] - s) / ljj;
+        }
+    }
+    true
+}
+
+/// Solves L Lᵀ x = b in place (L from [`cholesky_in_place`]).
+fn cholesky_solve(l: &[f64], k: usize, x: &mut [f64]) {
+    for i in 0..k {
+        x[i] = (x[i] - dot4(&l[i * k..i * k + i], &x[..i])) / l[i * k + i];
+    }
+    for i in (0..k).rev() {
+        let mut v = x[i];
+        for p in i + 1..k {
+            v -= l[p * k + i] * x[p];
+        }
+        x[i] = v / l[i * k + i];
+    }
+}
+
+/// Σ a_i b_i with four partial sums (lets the compiler use vector registers).
+fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
 }
 
 /// λ = (CCᵀ)⁻¹ C r.

@@ -71,7 +71,7 @@ pub struct Invariants {
 }
 
 /// The η-dependent invariants at one η.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct AtShape {
     /// s(η).
     pub s: Vec3,
@@ -136,34 +136,69 @@ impl Invariants {
 
     /// s(η), J(η), L(η) and ∂J/∂η.
     pub fn at(&self, eta: &[f64]) -> AtShape {
+        let mut out = AtShape::default();
+        self.at_into(eta, &mut out);
+        out
+    }
+
+    /// [`Invariants::at`] into `out` (its vectors reused: no allocation once sized). With
+    /// K_a = Σ_b J2_ab η_b (J2_ba = J2_abᵀ, so Σ_b J2_abᵀ η_b = K_aᵀ):
+    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a η_a (J1_a + K_a),
+    ///   L_b = L₀_b + Σ_a L1_ab η_a,   ∂J/∂η_a = J1_a + K_a + K_aᵀ,
+    /// 9 m² multiply-adds for the quadratic terms, element by element on the 3×3 arrays (the
+    /// generic `Mat3` operators go through `array::map`, which is not inlined).
+    pub fn at_into(&self, eta: &[f64], out: &mut AtShape) {
         let m = self.modes;
         let mut s = self.s0;
-        let mut j = self.j0;
-        let mut l = self.l0.clone();
-        let mut dj = self.j1.clone();
+        let mut j = self.j0.0;
+        out.l.clear();
+        out.l.extend_from_slice(&self.l0);
+        out.dj.clear();
         for a in 0..m {
-            s = s + self.s[a] * eta[a];
-            j = j + self.j1[a] * eta[a];
-            for b in 0..m {
-                let jab = self.j2[a * m + b];
-                j = j + jab * (eta[a] * eta[b]);
-                dj[a] = dj[a] + (jab + jab.transpose()) * eta[b];
-                l[b] = l[b] + self.l1[a * m + b] * eta[a];
+            let ea = eta[a];
+            s = s + self.s[a] * ea;
+            let mut k = [[0.0; 3]; 3];
+            for (jab, eb) in self.j2[a * m..(a + 1) * m].iter().zip(eta) {
+                for r in 0..3 {
+                    for c in 0..3 {
+                        k[r][c] += jab.0[r][c] * eb;
+                    }
+                }
+            }
+            let j1 = &self.j1[a].0;
+            let mut dj = [[0.0; 3]; 3];
+            for r in 0..3 {
+                for c in 0..3 {
+                    j[r][c] += (j1[r][c] + k[r][c]) * ea;
+                    dj[r][c] = j1[r][c] + (k[r][c] + k[c][r]);
+                }
+            }
+            out.dj.push(Mat3(dj));
+            for (lb, l1) in out.l.iter_mut().zip(&self.l1[a * m..(a + 1) * m]) {
+                *lb = *lb + *l1 * ea;
             }
         }
-        AtShape { s, j, l, dj }
+        out.s = s;
+        out.j = Mat3(j);
     }
 
     /// L̇ = Σ_j η̇_j L1_j, as columns.
     pub fn l_rate(&self, eta_dot: &[f64]) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        self.l_rate_into(eta_dot, &mut out);
+        out
+    }
+
+    /// [`Invariants::l_rate`] into `out` (resized to m).
+    pub fn l_rate_into(&self, eta_dot: &[f64], out: &mut Vec<Vec3>) {
         let m = self.modes;
-        let mut out = vec![Vec3::ZERO; m];
+        out.clear();
+        out.resize(m, Vec3::ZERO);
         for a in 0..m {
             for b in 0..m {
                 out[b] = out[b] + self.l1[a * m + b] * eta_dot[a];
             }
         }
-        out
     }
 
     /// S η̇.
