@@ -1,4 +1,4 @@
-//! The base that carries the deploying array (MODEL.md §3.2): the hub with every beam, lumped
+//! The base that carries the deploying array (docs/theory.md §2): the hub with every beam, lumped
 //! mass and plate other than the deploying one, elastic by its hub-fixed Ritz modes in the
 //! hub's floating frame.
 //!

@@ -1,4 +1,4 @@
-//! The deploying array on the flexible, free-floating base as one system (MODEL.md §3.2).
+//! The deploying array on the flexible, free-floating base as one system (docs/theory.md §2).
 //!
 //! Coordinates: the hub's position R and attitude quaternion (free hub only), the base's
 //! modal coordinates η (hub-fixed modes, [`super::base`]), the opening angles α. Speeds
@@ -54,7 +54,7 @@ pub enum Synchronisation {
     ElasticCable(f64),
 }
 
-/// A compliant latch per hinge (MODEL.md §3.2, "Compliant latch"): once hinge j has been
+/// A compliant latch per hinge (docs/theory.md §2.3a): once hinge j has been
 /// captured (the first time it reaches its latch angle α_j^L while opening) its moment gains
 /// −k_j (α_j − α_j^L) − c_j α̇_j for good; the hinge spring keeps acting.
 #[derive(Debug, Clone, PartialEq)]
@@ -1232,7 +1232,7 @@ pub struct CoupledLatch {
     /// ½ Δuᵀ M Δu, J (equal to the loss for a plastic impact).
     pub loss_metric: f64,
     /// Impulse the base receives at the root hinge, hub components: force (N·s) and moment
-    /// about the hinge point (N·m·s). Truncation-dependent on an elastic base (MODEL.md §3.2).
+    /// about the hinge point (N·m·s). Truncation-dependent on an elastic base (docs/theory.md §2).
     pub base_impulse: (Vec3, Vec3),
     /// The state just before the impact.
     pub state_before: Vec<f64>,

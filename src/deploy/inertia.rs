@@ -1,6 +1,6 @@
-//! Inertia invariants of an elastic body in a floating frame (MODEL.md §3.2: "small elastic
-//! deformation in the hub frame, exact rigid motion, all inertia coupling and all
-//! quadratic-velocity terms").
+//! Inertia invariants of an elastic body in a floating frame (docs/theory.md §2.1–2.2: small
+//! elastic deformation in the hub frame, exact rigid motion, all inertia coupling and all
+//! quadratic-velocity terms).
 //!
 //! The body is represented by mass points p (mass m_p, position r_p from the frame's origin O,
 //! displacement Φ_p η, Φ_p a 3×m matrix of the kept modes) and rotary inertias s (tensor I_s,
