@@ -211,7 +211,7 @@
     var W = canvas.width, H = canvas.height;
     var select = root.querySelector("select"), button = root.querySelector("button");
     var slider = root.querySelector("input[type=range]"), label = root.querySelector(".time");
-    var yaw = -0.6, pitch = 0.35, zoom = 1, frame = 0, phase = Math.PI / 2, timer = null;
+    var yaw = -0.85, pitch = 0.45, zoom = 1, frame = 0, phase = Math.PI / 2, timer = null;
     var ext = spec.extent, dep = spec.deploy;
     var what = dep ? "deploy" : (spec.modes.length ? "mode:0" : "structure");
     function add(a, b) { return [a[0] + b[0], a[1] + b[1], a[2] + b[2]]; }
@@ -227,13 +227,18 @@
       var k = mul(rho, 1 / t), c = Math.cos(t), s = Math.sin(t);
       return add(add(mul(p, c), mul(cross(k, p), s)), mul(k, dot(k, p) * (1 - c)));
     }
-    var center = (function () {
-      var s = [0, 0, 0], n = 0;
-      spec.beams.concat(spec.plates).forEach(function (c) { c.pts.forEach(function (p) { s = add(s, p); n++; }); });
-      s = add(s, spec.hub.center); n++;
-      return mul(s, 1 / n);
+    // The view's centre and size: the bounding box of the hub, beams and plates.
+    var box = (function () {
+      var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+      var take = function (p) { for (var i = 0; i < 3; i++) { lo[i] = Math.min(lo[i], p[i]); hi[i] = Math.max(hi[i], p[i]); } };
+      spec.beams.concat(spec.plates).forEach(function (c) { c.pts.forEach(take); });
+      var h = spec.hub, a = h.kind === "cylinder" ? mul(unit(h.axis), h.length / 2) : h.half;
+      take(add(h.center, a)); take(sub(h.center, a));
+      return [lo, hi];
     })();
-    function pxScale() { return zoom * 0.42 * Math.min(W, H) / ext; }
+    var center = mul(add(box[0], box[1]), 0.5);
+    ext = 0.5 * Math.sqrt(dot(sub(box[1], box[0]), sub(box[1], box[0]))) || ext;
+    function pxScale() { return zoom * 0.9 * Math.min(W, H) / (2 * ext); }
     // View coordinates: yaw about z, then pitch about the screen's x; depth grows away.
     function toView(d) {
       var cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);

@@ -76,6 +76,15 @@ fn unit_of<'a>(name: &'a str, ylabel: &'a str) -> Option<&'a str> {
     last(name).or_else(|| last(ylabel))
 }
 
+/// A structure's size for comparing rotations with lengths: its longest beam or plate side, m.
+pub fn structure_size(st: &crate::structure::Structure) -> f64 {
+    st.beams
+        .iter()
+        .map(|b| b.length)
+        .chain(st.plates.iter().map(|p| p.length.max(p.width)))
+        .fold(1e-3, f64::max)
+}
+
 /// The label a curve of rounding noise gets.
 pub const ZERO_LABEL: &str = "identically zero (rounding only)";
 
@@ -463,13 +472,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         "η [√kg·m]",
         modal,
     ));
-    let size = st
-        .beams
-        .iter()
-        .map(|b| b.length)
-        .chain(st.plates.iter().map(|p| p.length.max(p.width)))
-        .fold(1e-3, f64::max);
-    clean(&mut out, size);
+    clean(&mut out, structure_size(st));
     out
 }
 

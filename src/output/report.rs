@@ -693,13 +693,7 @@ fn handover_table(s: &Scenario, sim: &Simulation, r: &crate::simulation::Respons
         .max(h.energy_after + h.elastic_energy_after)
         .max(f64::MIN_POSITIVE);
     let p_scale = (2.0 * energy * s.structure.total_mass()).sqrt();
-    let size = s
-        .structure
-        .beams()
-        .iter()
-        .map(|b| b.length())
-        .chain(s.structure.plates().iter().map(|p| p.length()))
-        .fold(1.0, f64::max);
+    let size = super::figures::structure_size(&s.structure);
     let shown = |v: f64, scale: f64| {
         if v.abs() <= super::figures::NOISE_FLOOR * scale {
             "0".to_string()

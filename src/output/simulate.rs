@@ -321,13 +321,7 @@ fn handover_lines(o: &mut String, r: &Response) {
 /// largest peak of its quantity among the response's channels prints as 0 (lengths and
 /// angles compared through the structure's size, as in the figures).
 fn noise_floor<'a>(s: &Scenario, r: &'a Response) -> impl Fn(f64, &str) -> f64 + 'a {
-    let st = &s.structure;
-    let size = st
-        .beams
-        .iter()
-        .map(|b| b.length)
-        .chain(st.plates.iter().map(|p| p.length.max(p.width)))
-        .fold(1e-3, f64::max);
+    let size = super::figures::structure_size(&s.structure);
     let as_length = move |u: &str, v: f64| if u == "rad" { v * size } else { v };
     let family = |u: &str| {
         if u == "rad" {

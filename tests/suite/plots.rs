@@ -124,38 +124,30 @@ fn check_dir(plots: &Path) -> usize {
     checked
 }
 
+/// Runs `flexcraft <command> <example> --out <scratch>` and returns the output folder.
+fn run(command: &str, example_name: &str, tag: &str) -> std::path::PathBuf {
+    let dir = scratch(tag);
+    let out = bin()
+        .arg(command)
+        .arg(example(example_name))
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .expect("run");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dir
+}
+
 #[test]
 fn plots_have_distinct_ticks_unbroken_traces_and_matching_pngs() {
-    let dir = scratch("plots_seed");
-    let out = bin()
-        .arg("simulate")
-        .arg(example("seed.toml"))
-        .arg("--out")
-        .arg(&dir)
-        .arg("--quiet")
-        .output()
-        .expect("run");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let n = check_dir(&dir.join("plots"));
+    let n = check_dir(&run("simulate", "seed.toml", "plots_seed").join("plots"));
     assert!(n >= 15, "{n} figures");
-    let dir = scratch("plots_free_hub");
-    let out = bin()
-        .arg("modes")
-        .arg(example("free_hub.toml"))
-        .arg("--out")
-        .arg(&dir)
-        .output()
-        .expect("run");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(check_dir(&dir.join("plots")) >= 6);
+    let n = check_dir(&run("modes", "free_hub.toml", "plots_free_hub").join("plots"));
+    assert!(n >= 6, "{n} figures");
 }
 
 #[test]

@@ -47,18 +47,14 @@ terms = {{ bending = 20, torsion = 4, axial = 4 }}
     )
 }
 
-/// A cantilever hit at its tip by an impulse P along z, from rest: the classical series
-/// (e.g. Meirovitch, *Fundamentals of Vibrations*, §8) with modes normalised to
-/// ∫₀ᴸ X_n² dx = L, for which X_n(L)² = 4:
-///   w(L, t) = Σ_n 4P / (ρ A L ω_n) · sin ω_n t,   ω_n = β_n² √(EI/(ρA L⁴)),
-///   cos β_n cosh β_n = −1.
-/// The Ritz response keeps the same five modes (`modes = 5`).
-#[test]
-fn cantilever_tip_impulse_matches_the_series_solution() {
+/// The cantilever from rest hit at its tip by the impulse `p` (N·s) along z: the model, its
+/// modes, the response keeping five modes, 0.2 s at 2 kHz, and those settings.
+pub fn cantilever_tip_impulse(
+    p: f64,
+) -> (RitzModel, ModalAnalysis, ModalResponse, ResponseSettings) {
     let s = scenario(&cantilever());
     let model = RitzModel::assemble(&s.structure);
     let modal = ModalAnalysis::compute(&model).expect("modes");
-    let p = 0.01; // N·s
     let b = point_impulse(
         &model,
         ComponentId::Beam(0),
@@ -73,6 +69,19 @@ fn cantilever_tip_impulse_matches_the_series_solution() {
         ..ResponseSettings::default()
     };
     let resp = ModalResponse::new(&modal, &eta_dot, &settings);
+    (model, modal, resp, settings)
+}
+
+/// A cantilever hit at its tip by an impulse P along z, from rest: the classical series
+/// (e.g. Meirovitch, *Fundamentals of Vibrations*, §8) with modes normalised to
+/// ∫₀ᴸ X_n² dx = L, for which X_n(L)² = 4:
+///   w(L, t) = Σ_n 4P / (ρ A L ω_n) · sin ω_n t,   ω_n = β_n² √(EI/(ρA L⁴)),
+///   cos β_n cosh β_n = −1.
+/// The Ritz response keeps the same five modes (`modes = 5`).
+#[test]
+fn cantilever_tip_impulse_matches_the_series_solution() {
+    let p = 0.01; // N·s
+    let (model, modal, resp, settings) = cantilever_tip_impulse(p);
     let channels = standard_channels(&model);
     let hist = resp.sample(&modal, &channels, &settings);
     let c = channels

@@ -3,7 +3,7 @@
 //! Euler–Bernoulli closed forms, and the hub's momentum balance on a free spacecraft.
 
 use super::common::{bisect, scenario};
-use super::response::{cantilever, AREA, E, IY, L, RHO};
+use super::response::{cantilever_tip_impulse, AREA, E, IY, L, RHO};
 use flexcraft::deploy::chain::Hinge;
 use flexcraft::math::Vec3;
 use flexcraft::response::channels::standard_channels;
@@ -42,24 +42,8 @@ fn channel(channels: &[Channel], name: &str) -> usize {
 /// The force-summation channels (momentum rates of the beam) must give the same series.
 #[test]
 fn cantilever_root_moment_and_shear_match_the_series() {
-    let s = scenario(&cantilever());
-    let model = RitzModel::assemble(&s.structure);
-    let modal = ModalAnalysis::compute(&model).expect("modes");
     let p = 0.01;
-    let b = point_impulse(
-        &model,
-        ComponentId::Beam(0),
-        [L, 0.0],
-        Vec3::new(0.0, 0.0, p),
-    );
-    let eta_dot = modal_velocities(&modal, &b);
-    let settings = ResponseSettings {
-        duration: 0.2,
-        output_rate: 2000.0,
-        modes: Some(5),
-        ..ResponseSettings::default()
-    };
-    let resp = ModalResponse::new(&modal, &eta_dot, &settings);
+    let (model, modal, resp, settings) = cantilever_tip_impulse(p);
     let channels = beam_root_channels(&model);
     let hist = resp.sample(&modal, &channels, &settings);
     let (my, fz) = (
