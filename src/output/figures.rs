@@ -413,7 +413,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         out.push(fig(
             format!("response_{stem}_tip"),
             format!(
-                "{} tip: elastic deflection in both bending planes (fig. 2.4)",
+                "{} tip: elastic deflection in both bending planes (the paper's fig. 2.4)",
                 b.name
             ),
             "deflection [m]",
@@ -421,7 +421,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         ));
         out.push(fig(
             format!("response_{stem}_twist"),
-            format!("{} tip: elastic twist (fig. 2.4)", b.name),
+            format!("{} tip: elastic twist (the paper's fig. 2.4)", b.name),
             "twist [rad]",
             pick(&|c| c.kind == kind && c.unit == "rad"),
         ));
@@ -432,20 +432,23 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         };
         out.push(fig(
             format!("response_{stem}_tip"),
-            format!("{} tip corners: elastic deflection (fig. 2.5)", p.name),
+            format!(
+                "{} tip corners: elastic deflection (the paper's fig. 2.5)",
+                p.name
+            ),
             "deflection [m]",
             pick(&|c| c.kind == kind),
         ));
     }
     out.push(fig(
         "response_hub_translation".into(),
-        "hub translation along the structure axes (fig. 2.6)".into(),
+        "hub translation along the structure axes (the paper's fig. 2.6)".into(),
         "translation [m]",
         pick(&|c| c.kind == ChannelKind::HubTranslation),
     ));
     out.push(fig(
         "response_hub_rotation".into(),
-        "hub rotation about the structure axes (fig. 2.7)".into(),
+        "hub rotation about the structure axes (the paper's fig. 2.7)".into(),
         "rotation [rad]",
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));

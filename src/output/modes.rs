@@ -284,12 +284,12 @@ pub fn write_modes(
                 "x [m]",
                 "y [m]",
                 "z [m]",
-                "ux [m]",
-                "uy [m]",
-                "uz [m]",
-                "rx [rad]",
-                "ry [rad]",
-                "rz [rad]",
+                "ux [m/√kg, mass-normalised]",
+                "uy [m/√kg, mass-normalised]",
+                "uz [m/√kg, mass-normalised]",
+                "rx [rad/√kg, mass-normalised]",
+                "ry [rad/√kg, mass-normalised]",
+                "rz [rad/√kg, mass-normalised]",
             ])?;
             for (name, _, samples) in sample_all(model, &m.shape) {
                 for p in samples {

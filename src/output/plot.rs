@@ -44,8 +44,9 @@ pub fn register_font() {
 
 type Lines = Vec<Vec<(f64, f64, f64)>>;
 
-/// Undeformed and deformed polylines of every elastic component.
-fn polylines(model: &RitzModel, q: &[f64]) -> (Lines, Lines) {
+/// Undeformed and deformed polylines of every elastic component, and the exaggeration factor
+/// (the largest displacement drawn as 12 % of the structure's extent).
+fn polylines(model: &RitzModel, q: &[f64]) -> (Lines, Lines, f64) {
     let mut undeformed = Vec::new();
     let mut deformed = Vec::new();
     let samples = super::modes::sample_all(model, q);
@@ -89,7 +90,7 @@ fn polylines(model: &RitzModel, q: &[f64]) -> (Lines, Lines) {
             }
         }
     }
-    (undeformed, deformed)
+    (undeformed, deformed, scale)
 }
 
 fn draw_view<DB: DrawingBackend>(
@@ -113,7 +114,7 @@ fn draw_view<DB: DrawingBackend>(
     let span = (x1 - x0).max(y1 - y0).max(1e-9) * 1.1;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
+        .caption(title, ("sans-serif", 17))
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(48)
@@ -128,7 +129,7 @@ fn draw_view<DB: DrawingBackend>(
         .y_desc(labels.1)
         .x_label_formatter(&|v| tick_label(*v, span))
         .y_label_formatter(&|v| tick_label(*v, span))
-        .label_style(("sans-serif", 13))
+        .label_style(("sans-serif", 14))
         .draw()
         .map_err(|e| e.to_string())?;
     for l in und {
@@ -163,27 +164,50 @@ fn draw_mode<DB: DrawingBackend>(
         mode.frequency_hz(),
         mode.dominant()
     );
+    let (und, def, scale) = polylines(model, &mode.shape);
+    let title = format!("{title}; deflection ×{scale:.3e} (mass-normalised shape)");
     let root = root
         .titled(&title, ("sans-serif", 22))
         .map_err(|e| e.to_string())?;
-    let (und, def) = polylines(model, &mode.shape);
+    // The two views that show the most of the deflection: drop the axis it moves least
+    // along, then the next one.
+    let mut motion = [0.0_f64; 3];
+    for (u, d) in und.iter().zip(&def) {
+        for (a, b) in u.iter().zip(d) {
+            motion[0] += (b.0 - a.0).abs();
+            motion[1] += (b.1 - a.1).abs();
+            motion[2] += (b.2 - a.2).abs();
+        }
+    }
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| motion[i].total_cmp(&motion[j]));
+    let names = ["x", "y", "z"];
+    let plane = |dropped: usize| -> (usize, usize) {
+        match dropped {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        }
+    };
     let (a, b) = root.split_horizontally(root.dim_in_pixel().0 / 2);
-    draw_view(
-        &a,
-        "side view (x–z), grey: undeformed",
-        (0, 2),
-        ("x [m]", "z [m]"),
-        &und,
-        &def,
-    )?;
-    draw_view(
-        &b,
-        "top view (x–y), blue: deformed (exaggerated)",
-        (0, 1),
-        ("x [m]", "y [m]"),
-        &und,
-        &def,
-    )?;
+    for (area, dropped, what) in [
+        (&a, order[0], "grey: undeformed"),
+        (&b, order[1], "blue: deformed"),
+    ] {
+        let (h, v) = plane(dropped);
+        let labels = (format!("{} [m]", names[h]), format!("{} [m]", names[v]));
+        draw_view(
+            area,
+            &format!(
+                "view along {} ({}–{}), {what}",
+                names[dropped], names[h], names[v]
+            ),
+            (h, v),
+            (&labels.0, &labels.1),
+            &und,
+            &def,
+        )?;
+    }
     root.present().map_err(|e| e.to_string())
 }
 
