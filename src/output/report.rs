@@ -62,6 +62,72 @@ fn plot(f: &Figure) -> String {
 }
 
 /// Two orthogonal views (x–z and x–y) of the deployed structure, labelled.
+/// Points on the hub's surface: its cylinder's two end circles, or its equivalent box's
+/// corners (uniform box with the hub's principal moments, as in the 3-D view).
+fn hub_outline(st: &Structure) -> Vec<Vec3> {
+    let hub = st.hub();
+    if let Some(c) = hub.shape() {
+        let a = c.axis * (1.0 / c.axis.norm());
+        let helper = if a.get(0).abs() < 0.9 {
+            Vec3::new(1.0, 0.0, 0.0)
+        } else {
+            Vec3::new(0.0, 1.0, 0.0)
+        };
+        let u = a.cross(helper).normalized();
+        let v = a.cross(u);
+        let r = c.diameter / 2.0;
+        let mut out = Vec::new();
+        for end in [-0.5, 0.5] {
+            for k in 0..32 {
+                let t = std::f64::consts::TAU * k as f64 / 32.0;
+                out.push(c.center + a * (end * c.length) + u * (r * t.cos()) + v * (r * t.sin()));
+            }
+        }
+        return out;
+    }
+    let h = super::view3d::box_half_sides(st);
+    let mut out = Vec::new();
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                out.push(hub.center_of_mass() + Vec3::new(sx * h[0], sy * h[1], sz * h[2]));
+            }
+        }
+    }
+    out
+}
+
+/// The convex hull of points in the plane (Andrew's monotone chain), counter-clockwise.
+fn convex_hull(mut p: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    p.dedup();
+    if p.len() < 3 {
+        return p;
+    }
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64)> = Vec::new();
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
+            Box::new(p.iter())
+        } else {
+            Box::new(p.iter().rev())
+        };
+        for &q in iter {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(q);
+        }
+        hull.pop();
+    }
+    hull
+}
+
 fn sketch(st: &Structure) -> String {
     // Segments and labelled points in the structure frame.
     let mut segs: Vec<(Vec3, Vec3, &'static str)> = Vec::new();
@@ -100,6 +166,7 @@ fn sketch(st: &Structure) -> String {
             .iter()
             .flat_map(|(a, b, _)| [*a, *b])
             .chain(labels.iter().map(|l| l.0))
+            .chain(hub_outline(st))
             .map(|p| (p.get(axes.0), p.get(axes.1)))
             .collect();
         let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -119,9 +186,21 @@ fn sketch(st: &Structure) -> String {
             out,
             "<svg viewBox=\"0 0 {w} {h}\" width=\"49%\" role=\"img\"><rect width=\"{w}\" height=\"{h}\" fill=\"#fbfbfd\" stroke=\"#ccd\"/><text x=\"10\" y=\"18\" font-size=\"13\" font-weight=\"bold\">{title}, m</text>"
         );
+        // The hub as its body: the outline (convex hull) of its cylinder or box, projected.
+        let outline = convex_hull(
+            hub_outline(st)
+                .iter()
+                .map(|p| (px(p.get(axes.0)), py(p.get(axes.1))))
+                .collect(),
+        );
         let _ = write!(
             out,
-            "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"9\" fill=\"#555\"/>",
+            "<polygon points=\"{}\" fill=\"#cfd5df\" stroke=\"#556\"/><circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"#333\"/>",
+            outline
+                .iter()
+                .map(|(x, y)| format!("{x:.1},{y:.1}"))
+                .collect::<Vec<_>>()
+                .join(" "),
             px(hub.get(axes.0)),
             py(hub.get(axes.1))
         );
@@ -140,12 +219,21 @@ fn sketch(st: &Structure) -> String {
                 py(b.get(axes.1))
             );
         }
+        // Labels never overprint: one that would land on an earlier one moves down a line.
+        let mut placed: Vec<(f64, f64)> = Vec::new();
         for (p, name) in &labels {
+            let x = px(p.get(axes.0)) + 6.0;
+            let mut y = py(p.get(axes.1)) - 6.0;
+            while placed
+                .iter()
+                .any(|(a, b)| (a - x).abs() < 60.0 && (b - y).abs() < 14.0)
+            {
+                y += 15.0;
+            }
+            placed.push((x, y));
             let _ = write!(
                 out,
-                "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"13\" fill=\"#222\">{}</text>",
-                px(p.get(axes.0)) + 6.0,
-                py(p.get(axes.1)) - 6.0,
+                "<text x=\"{x:.1}\" y=\"{y:.1}\" font-size=\"13\" fill=\"#222\">{}</text>",
                 esc(name)
             );
         }

@@ -38,9 +38,15 @@ fn hub_json(st: &Structure) -> Value {
         return json!({"kind": "cylinder", "center": p3(c.center), "axis": p3(c.axis),
                       "radius": r5(c.diameter / 2.0), "length": r5(c.length)});
     }
-    // A uniform box with the hub's principal moments along the structure axes (products of
-    // inertia ignored): I_x = m (b² + c²)/3 for half-sides a, b, c, so
-    // a² = 3 (I_y + I_z − I_x) / (2m).
+    let h = box_half_sides(st);
+    json!({"kind": "box", "center": p3(hub.center_of_mass()), "half": [r5(h[0]), r5(h[1]), r5(h[2])]})
+}
+
+/// The half-sides of the uniform box with the hub's principal moments along the structure
+/// axes (products of inertia ignored): I_x = m (b² + c²)/3 for half-sides a, b, c, so
+/// a² = 3 (I_y + I_z − I_x) / (2m).
+pub(crate) fn box_half_sides(st: &Structure) -> [f64; 3] {
+    let hub = st.hub();
     let j = hub.inertia().0;
     let m = hub.mass().max(1e-9);
     let half = |i: usize| {
@@ -51,7 +57,7 @@ fn hub_json(st: &Structure) -> Value {
         );
         (3.0 * (b + c - a) / (2.0 * m)).max(1e-6).sqrt()
     };
-    json!({"kind": "box", "center": p3(hub.center_of_mass()), "half": [r5(half(0)), r5(half(1)), r5(half(2))]})
+    [half(0), half(1), half(2)]
 }
 
 /// Outer diameter of a beam's section from its area A and polar moment J: for a tube
