@@ -526,6 +526,12 @@
           else if (!(ink(f1) > 0.01)) v3 = "last frame blank";
           else if (!differ(f0, f1)) v3 = "frames 0 and last are the same";
         }
+        // Play starts the animation (the button turns to pause) and a second click stops it.
+        var button = document.querySelector(".view3d button");
+        button.click();
+        if (v3 === "ok" && button.textContent !== "pause") v3 = "play did not start";
+        button.click();
+        if (v3 === "ok" && button.textContent !== "play") v3 = "pause did not stop";
         var before = V.pixels(); V.rotate(0.7); var after = V.pixels();
         if (v3 === "ok" && !differ(before, after)) v3 = "rotation did not change the picture";
         V.set("mode:0", Math.PI / 2); var m1 = V.pixels(); V.set("mode:0", -Math.PI / 2); var m2 = V.pixels();

@@ -768,20 +768,9 @@ fn handover_table(s: &Scenario, sim: &Simulation, r: &crate::simulation::Respons
             r.history.energy_drift(),
         ),
     ];
-    // Rounding noise reads 0 (the exact values stay in data-value and summary.json): energies
-    // against the largest kinetic energy of the run (the hand-over's totals included), ratios
-    // against 1, momenta against √(2 E m) of the
-    // spacecraft (and that times its size for angular momentum).
-    let energy = sim
-        .deployment
-        .samples
-        .iter()
-        .map(|x| x.kinetic)
-        .fold(h.energy_before + h.elastic_energy_before, f64::max)
-        .max(h.energy_after + h.elastic_energy_after)
-        .max(f64::MIN_POSITIVE);
-    let p_scale = (2.0 * energy * s.structure.total_mass()).sqrt();
-    let size = super::figures::structure_size(&s.structure);
+    // Rounding noise reads 0 (the exact values stay in data-value and summary.json), against
+    // the scales of `handover_scales` (ratios against 1).
+    let (energy, p_scale, l_scale) = super::simulate::handover_scales(s, sim, r);
     let shown = |v: f64, scale: f64| {
         if v.abs() <= super::figures::NOISE_FLOOR * scale {
             "0".to_string()
@@ -822,7 +811,7 @@ fn handover_table(s: &Scenario, sim: &Simulation, r: &crate::simulation::Respons
         let _ = write!(o, "<tr><td class=\"l\">{label}</td><td><table>");
         let _ = write!(o, "<tr>");
         let scale = if label.starts_with("angular") {
-            p_scale * size
+            l_scale
         } else {
             p_scale
         };

@@ -256,7 +256,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
             r.modal.modes.len() - shown
         );
     }
-    handover_lines(&mut o, r);
+    handover_lines(&mut o, r, handover_scales(s, sim, r));
     response_lines(&mut o, s, sim, r);
     for w in &sim.warnings {
         let _ = writeln!(o, "warning: {w}");
@@ -265,7 +265,7 @@ pub fn simulate_table(s: &Scenario, sim: &Simulation) -> String {
 }
 
 /// The hand-over's lines of the terminal summary.
-fn handover_lines(o: &mut String, r: &Response) {
+fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64, f64)) {
     let h = &r.handover;
     let lost = h.energy_before - h.energy_after;
     let _ = writeln!(
@@ -302,19 +302,40 @@ fn handover_lines(o: &mut String, r: &Response) {
         "  kept modes carry {:.6} % of the hand-over energy",
         100.0 * r.modal.captured_energy_fraction
     );
-    let f = |v: Vec3| format!("[{:.6e}, {:.6e}, {:.6e}]", v.0[0], v.0[1], v.0[2]);
+    // Rounding noise (within 1e-9 of the run's momentum scale) reads 0.
+    let f = |v: Vec3, scale: f64| {
+        let v = v.0.map(|x| super::snap(x, scale));
+        format!("[{:.6e}, {:.6e}, {:.6e}]", v[0], v[1], v[2])
+    };
     let _ = writeln!(
         o,
         "  momentum before: linear {} N·s, angular {} N·m·s",
-        f(h.momentum_before.linear),
-        f(h.momentum_before.angular)
+        f(h.momentum_before.linear, p_scale),
+        f(h.momentum_before.angular, l_scale)
     );
     let _ = writeln!(
         o,
         "  momentum after:  linear {} N·s, angular {} N·m·s",
-        f(h.momentum_after.linear),
-        f(h.momentum_after.angular)
+        f(h.momentum_after.linear, p_scale),
+        f(h.momentum_after.angular, l_scale)
     );
+}
+
+/// The hand-over's scales (energy J, linear momentum N·s, angular momentum N·m·s) against
+/// which rounding noise reads 0: the largest kinetic energy of the run (the hand-over's
+/// totals included), √(2 E m) of the spacecraft, and that times its size.
+pub(crate) fn handover_scales(s: &Scenario, sim: &Simulation, r: &Response) -> (f64, f64, f64) {
+    let h = &r.handover;
+    let energy = sim
+        .deployment
+        .samples
+        .iter()
+        .map(|x| x.kinetic)
+        .fold(h.energy_before + h.elastic_energy_before, f64::max)
+        .max(h.energy_after + h.elastic_energy_after)
+        .max(f64::MIN_POSITIVE);
+    let p = (2.0 * energy * s.structure.total_mass()).sqrt();
+    (energy, p, p * super::figures::structure_size(&s.structure))
 }
 
 /// Rounding noise in the terminal: a value at most [`super::figures::NOISE_FLOOR`] times the
@@ -363,12 +384,19 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
             ChannelKind::BeamTip { .. } | ChannelKind::PlateTip { .. }
         ) {
             let (p, t) = r.history.peak(c);
-            let p = snap(p, ch.unit);
-            let _ = writeln!(
-                o,
-                "  peak {:<34} {:>13.6e} {} at t = {:.3} s",
-                ch.label, p, ch.unit, t
-            );
+            if snap(p, ch.unit) == 0.0 {
+                let _ = writeln!(
+                    o,
+                    "  peak {:<34} {:>13} {} (identically zero: rounding only)",
+                    ch.label, "0", ch.unit
+                );
+            } else {
+                let _ = writeln!(
+                    o,
+                    "  peak {:<34} {:>13.6e} {} at t = {:.3} s",
+                    ch.label, p, ch.unit, t
+                );
+            }
         }
     }
     let peaks = peak_loads(sim);
@@ -407,6 +435,16 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
             .collect();
         format!("[{}]", v.join(", "))
     };
+    // Rigid-body rates within rounding of the run's scales (√(2E/m), and over the size) read 0.
+    let (_, p_scale, l_scale) = handover_scales(s, sim, r);
+    let m = s.structure.total_mass();
+    let rv = rv.map(|v| super::snap(v, p_scale / m));
+    let rw = rw.map(|v| {
+        super::snap(
+            v,
+            l_scale / m / super::figures::structure_size(&s.structure).powi(2),
+        )
+    });
     let _ = writeln!(
         o,
         "  hub drift: translation at the end {} m; rigid-body velocity [{:.6e}, {:.6e}, {:.6e}] m/s",
