@@ -22,9 +22,25 @@ pub fn elastic_omegas(modes: &ModalAnalysis) -> Vec<f64> {
 
 /// A fixed-hub cantilever plate of length 1, width 1/aspect, D = ρh = 1 (so λ = ω).
 pub fn cfff_plate(aspect: f64, basis: &str, nl: usize, nw: usize) -> String {
+    clamped_plate(1.0, 1.0 / aspect, 1.0, 1.0, 0.3, basis, nl, nw)
+}
+
+/// A plate named "plate" of length a and width b, bending stiffness D, areal density μ and
+/// Poisson ratio ν, clamped along its root edge to a fixed hub; nl × nw terms of `basis`.
+#[allow(clippy::too_many_arguments)]
+pub fn clamped_plate(
+    a: f64,
+    b: f64,
+    d: f64,
+    mu: f64,
+    nu: f64,
+    basis: &str,
+    nl: usize,
+    nw: usize,
+) -> String {
     format!(
         r#"
-name = "CFFF plate"
+name = "clamped plate"
 [hub]
 motion = "fixed"
 mass = 1.0
@@ -36,16 +52,15 @@ parent = "hub"
 root = [0.0, 0.0, 0.0]
 length_axis = [1.0, 0.0, 0.0]
 normal = [0.0, 0.0, 1.0]
-length = 1.0
-width = {w}
-areal_density = 1.0
-bending_stiffness = 1.0
-poisson_ratio = 0.3
+length = {a}
+width = {b}
+areal_density = {mu}
+bending_stiffness = {d}
+poisson_ratio = {nu}
 terms = {{ length = {nl}, width = {nw} }}
 [ritz]
 basis = "{basis}"
-"#,
-        w = 1.0 / aspect
+"#
     )
 }
 

@@ -2,7 +2,7 @@
 //! moment and shear and a plate's bending moment across a hinge line against the
 //! Euler–Bernoulli closed forms, and the hub's momentum balance on a free spacecraft.
 
-use super::common::{bisect, scenario};
+use super::common::{bisect, clamped_plate, scenario};
 use super::response::{cantilever_tip_impulse, AREA, E, IY, L, RHO};
 use flexcraft::deploy::chain::Hinge;
 use flexcraft::math::Vec3;
@@ -99,28 +99,7 @@ fn cantilever_root_moment_and_shear_match_the_series() {
 #[test]
 fn plate_hinge_line_moments_match_the_beam_mode() {
     let (a, b, d, mu): (f64, f64, f64, f64) = (4.0, 0.5, 3.0, 2.0);
-    let toml = format!(
-        r#"
-name = "narrow plate"
-[hub]
-motion = "fixed"
-mass = 1.0
-inertia = [1.0, 1.0, 1.0]
-center_of_mass = [0.0, 0.0, 0.0]
-[[plates]]
-name = "wing"
-parent = "hub"
-root = [0.0, 0.0, 0.0]
-length_axis = [1.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-length = {a}
-width = {b}
-areal_density = {mu}
-bending_stiffness = {d}
-poisson_ratio = 0.0
-terms = {{ length = 14, width = 4 }}
-"#
-    );
+    let toml = clamped_plate(a, b, d, mu, 0.0, "legendre", 14, 4);
     let s = scenario(&toml);
     let model = RitzModel::assemble(&s.structure);
     let modal = ModalAnalysis::compute(&model).expect("modes");
@@ -139,7 +118,7 @@ terms = {{ length = 14, width = 4 }}
         initial_rate: 0.0,
     };
     let mut channels = standard_channels(&model);
-    channels.extend(latch_channels(&model, "wing", &[hinge; 3]));
+    channels.extend(latch_channels(&model, "plate", &[hinge; 3]));
     let settings = ResponseSettings {
         duration: 0.0,
         output_rate: 1.0,
@@ -150,7 +129,7 @@ terms = {{ length = 14, width = 4 }}
     let zero = vec![0.0; eta0.len()];
     let resp = ModalResponse::with_initial(&modal, &eta0, &zero, &settings);
     let hist = resp.sample(&modal, &channels, &settings);
-    let tip = hist.values[(0, channel(&channels, "wing_tip_plus"))];
+    let tip = hist.values[(0, channel(&channels, "plate_tip_plus"))];
     for k in 1..=3 {
         let xi = (k - 1) as f64 / 3.0;
         let exact = d * b * (beta / a).powi(2) * d2(xi) / x1 * tip;
