@@ -292,7 +292,22 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
     );
     if c.base.hub_motion == HubMotion::Free {
         let b = final_body(r);
-        let (p, a, v, w) = (b.hub_position, b.hub_rotation, b.hub_velocity, b.hub_rate);
+        // Each quantity's components within rounding of its largest over the run read 0.
+        let largest = |f: &dyn Fn(&crate::deploy::BodySample) -> [f64; 3]| {
+            r.samples
+                .iter()
+                .filter_map(|x| x.body.as_deref())
+                .flat_map(|x| f(x))
+                .fold(0.0_f64, |m, v| m.max(v.abs()))
+        };
+        let clean = |v: [f64; 3], f: &dyn Fn(&crate::deploy::BodySample) -> [f64; 3]| {
+            let scale = largest(f);
+            v.map(|x| super::snap(x, scale))
+        };
+        let p = clean(b.hub_position, &|x| x.hub_position);
+        let a = clean(b.hub_rotation, &|x| x.hub_rotation);
+        let v = clean(b.hub_velocity, &|x| x.hub_velocity);
+        let w = clean(b.hub_rate, &|x| x.hub_rate);
         let _ = writeln!(
             s,
             "hub (centre of mass, inertial axes): position [{:.6e}, {:.6e}, {:.6e}] m, rotation vector [{:.6e}, {:.6e}, {:.6e}] rad; velocity [{:.6e}, {:.6e}, {:.6e}] m/s, rate [{:.6e}, {:.6e}, {:.6e}] rad/s",
