@@ -297,7 +297,7 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
             r.samples
                 .iter()
                 .filter_map(|x| x.body.as_deref())
-                .flat_map(|x| f(x))
+                .flat_map(f)
                 .fold(0.0_f64, |m, v| m.max(v.abs()))
         };
         let clean = |v: [f64; 3], f: &dyn Fn(&crate::deploy::BodySample) -> [f64; 3]| {
