@@ -98,23 +98,11 @@ pub const ZERO_LABEL: &str = "identically zero (rounding only)";
 ///   "(coincides with …)", since it is drawn under it.
 pub fn clean(figs: &mut [Figure], length: f64) {
     let peak = |c: &Curve| c.2.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
-    let as_length = |unit: &str, p: f64| match unit {
-        "rad" => p * length,
-        _ => p,
-    };
-    fn family(unit: &str) -> &str {
-        if unit == "rad" {
-            "m"
-        } else {
-            unit
-        }
-    }
-    let mut reference: std::collections::BTreeMap<String, f64> = Default::default();
+    let mut reference = NoiseReference::new(length);
     for f in figs.iter() {
         for c in &f.curves {
             if let Some(u) = unit_of(&c.0, f.ylabel) {
-                let e = reference.entry(family(u).to_string()).or_insert(0.0);
-                *e = e.max(as_length(u, peak(c)));
+                reference.observe(u, peak(c));
             }
         }
     }
@@ -124,9 +112,8 @@ pub fn clean(figs: &mut [Figure], length: f64) {
             let Some(u) = unit_of(&c.0, ylabel) else {
                 continue;
             };
-            let r = reference.get(family(u)).copied().unwrap_or(0.0);
-            let p = as_length(u, peak(c));
-            if r > 0.0 && p <= NOISE_FLOOR * r && p > 0.0 {
+            let p = peak(c);
+            if p > 0.0 && reference.is_noise(u, p) {
                 c.2.iter_mut().for_each(|v| *v = 0.0);
                 c.0 = format!("{}: {ZERO_LABEL}", c.0);
             } else if p == 0.0 && !c.0.ends_with(ZERO_LABEL) {
@@ -149,6 +136,46 @@ pub fn clean(figs: &mut [Figure], length: f64) {
                 f.curves[i].0 = format!("{} (coincides with {other})", f.curves[i].0);
             }
         }
+    }
+}
+
+/// The largest magnitude of every quantity (by unit) in one phase of a run, against which
+/// rounding noise is judged ([`NOISE_FLOOR`]); lengths (m) and angles (rad) are one quantity
+/// through a structure's size (1 rad of rotation ~ `size` m).
+#[derive(Debug, Clone)]
+pub struct NoiseReference {
+    size: f64,
+    largest: std::collections::BTreeMap<String, f64>,
+}
+
+impl NoiseReference {
+    /// No quantity seen yet; `size` converts angles to lengths.
+    pub fn new(size: f64) -> Self {
+        Self {
+            size,
+            largest: Default::default(),
+        }
+    }
+
+    /// The quantity a unit belongs to and the magnitude in that quantity's terms.
+    fn key(&self, unit: &str, magnitude: f64) -> (String, f64) {
+        match unit {
+            "rad" => ("m".to_string(), magnitude.abs() * self.size),
+            _ => (unit.to_string(), magnitude.abs()),
+        }
+    }
+
+    /// Records a magnitude of a quantity in `unit`.
+    pub fn observe(&mut self, unit: &str, magnitude: f64) {
+        let (quantity, m) = self.key(unit, magnitude);
+        let e = self.largest.entry(quantity).or_insert(0.0);
+        *e = e.max(m);
+    }
+
+    /// `magnitude` (in `unit`) is at most [`NOISE_FLOOR`] times the largest of its quantity.
+    pub fn is_noise(&self, unit: &str, magnitude: f64) -> bool {
+        let (quantity, m) = self.key(unit, magnitude);
+        m <= NOISE_FLOOR * self.largest.get(&quantity).copied().unwrap_or(0.0)
     }
 }
 

@@ -342,23 +342,13 @@ pub(crate) fn handover_scales(s: &Scenario, sim: &Simulation, r: &Response) -> (
 /// largest peak of its quantity among the response's channels prints as 0 (lengths and
 /// angles compared through the structure's size, as in the figures).
 fn noise_floor<'a>(s: &Scenario, r: &'a Response) -> impl Fn(f64, &str) -> f64 + 'a {
-    let size = super::figures::structure_size(&s.structure);
-    let as_length = move |u: &str, v: f64| if u == "rad" { v * size } else { v };
-    let family = |u: &str| {
-        if u == "rad" {
-            "m".to_string()
-        } else {
-            u.to_string()
-        }
-    };
-    let mut reference: std::collections::BTreeMap<String, f64> = Default::default();
+    let mut reference =
+        super::figures::NoiseReference::new(super::figures::structure_size(&s.structure));
     for (c, ch) in r.channels.iter().enumerate() {
-        let e = reference.entry(family(ch.unit)).or_insert(0.0);
-        *e = e.max(as_length(ch.unit, r.history.peak(c).0));
+        reference.observe(ch.unit, r.history.peak(c).0);
     }
     move |v: f64, unit: &str| {
-        let r = reference.get(&family(unit)).copied().unwrap_or(0.0);
-        if as_length(unit, v.abs()) <= super::figures::NOISE_FLOOR * r {
+        if reference.is_noise(unit, v) {
             0.0
         } else {
             v
