@@ -321,32 +321,29 @@ fn body_figures(r: &DeploymentResult, beam_names: &[String], markers: &[f64]) ->
     };
     let mut figs = Vec::new();
     let comp = |f: &dyn Fn(&crate::deploy::BodySample) -> f64, k: usize| body(k).map_or(0.0, f);
-    let xyz = ["x", "y", "z"];
-    let hub: Vec<Curve> = (0..3)
-        .map(|j| {
-            curve(format!("hub {}", xyz[j]), m, t, |k| {
-                comp(&|b| b.hub_position[j], k)
+    // The x, y, z components of a vector of the body sample, one curve each.
+    let components = |prefix: &str, get: fn(&crate::deploy::BodySample) -> [f64; 3]| {
+        ["x", "y", "z"]
+            .iter()
+            .enumerate()
+            .map(|(j, axis)| {
+                curve(format!("{prefix} {axis}"), m, t, |k| {
+                    comp(&|b| get(b)[j], k)
+                })
             })
-        })
-        .collect();
+            .collect::<Vec<Curve>>()
+    };
     figs.push(fig(
         "hub",
         "hub centre of mass (inertial)",
         "position [m]",
-        hub,
+        components("hub", |b| b.hub_position),
     ));
-    let rot: Vec<Curve> = (0..3)
-        .map(|j| {
-            curve(format!("rotation {}", xyz[j]), m, t, |k| {
-                comp(&|b| b.hub_rotation[j], k)
-            })
-        })
-        .collect();
     figs.push(fig(
         "hub_attitude",
         "hub attitude (rotation vector, inertial)",
         "rotation [rad]",
-        rot,
+        components("rotation", |b| b.hub_rotation),
     ));
     let beams = body(0).map_or(0, |b| b.root_loads.len());
     let norm = |l: &[f64]| l.iter().map(|x| x * x).sum::<f64>().sqrt();
