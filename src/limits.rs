@@ -186,6 +186,12 @@ pub const PANEL_LENGTH: Limit = closed(1e-3, 1e4, "m");
 pub const MAX_PANEL_LENGTH_RATIO: f64 = 100.0;
 /// Most panels a deployment may have (a 100-panel chain runs in about a second).
 pub const MAX_PANELS: usize = 100;
+/// `[ritz] tolerance`: relative, on frequencies (rounding sets the floor).
+pub const RITZ_TOLERANCE: Limit = closed(1e-10, 0.1, "");
+/// `[ritz] max_dof`: the dense matrices of the largest model stay within memory.
+pub const MAX_RITZ_DOF: usize = 4000;
+/// `[ritz] modes`: most wanted elastic modes.
+pub const MAX_RITZ_MODES: usize = 500;
 /// Relative integration tolerance.
 pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
 /// Deployment end time and response duration.

@@ -25,4 +25,5 @@ mod suite {
     pub mod report;
     pub mod response;
     pub mod response_loads;
+    pub mod term_selection;
 }

@@ -10,6 +10,7 @@
 pub mod assembly;
 pub mod eigen;
 pub mod modes;
+pub mod refine;
 pub mod shapes;
 
 pub use assembly::{Element, ElementKind, FieldKind, FieldRange, RitzModel, HUB_DOF};

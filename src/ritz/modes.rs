@@ -14,7 +14,7 @@
 //! m_eff,i,d = (φ_iᵀ M_e,d)², whose sum over a complete basis is the appendages' rigid mass.
 
 use super::assembly::{ElementKind, RitzModel, HUB_DOF};
-use super::eigen::generalized_symmetric;
+use super::eigen::{generalized_symmetric, lowest};
 use super::RitzError;
 use crate::math::Vec3;
 use crate::structure::{Attachment, ComponentId, HubMotion, RigidBody};
@@ -105,6 +105,14 @@ pub const EFFECTIVE_MASS_FLOOR: f64 = 1e-12;
 impl ModalAnalysis {
     /// Solves for every mode of the model.
     pub fn compute(model: &RitzModel) -> Result<Self, RitzError> {
+        Self::compute_lowest(model, None)
+    }
+
+    /// Solves for the `count` lowest elastic modes only (all of them for `None`, or when
+    /// `count` is not well below the number of coordinates), by
+    /// [`super::eigen::lowest`]: the fast route when a run needs ten modes of a model with a
+    /// thousand coordinates. The hub-fixed list (effective masses) is cut to the same count.
+    pub fn compute_lowest(model: &RitzModel, count: Option<usize>) -> Result<Self, RitzError> {
         let n = model.dof();
         let ne = n - HUB_DOF;
         let m = &model.mass;
@@ -113,10 +121,11 @@ impl ModalAnalysis {
         let kee = k.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
         let mer = m.submatrix(HUB_DOF, 0, ne, HUB_DOF).to_owned();
         let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
+        let wanted = count.map_or(ne, |c| c.min(ne));
 
-        let (lam_f, phi_f) = generalized_symmetric(&kee, &mee)?;
+        let (lam_f, phi_f) = solve(&kee, &mee, wanted)?;
         let appendage_mass = appendage_mass(model, &mrr);
-        let hub_fixed: Vec<HubFixedMode> = (0..ne)
+        let hub_fixed: Vec<HubFixedMode> = (0..wanted)
             .map(|j| {
                 let mut eff = [0.0; 6];
                 for (d, e) in eff.iter_mut().enumerate() {
@@ -140,7 +149,7 @@ impl ModalAnalysis {
         let motion = model.structure.hub.motion;
         match motion {
             HubMotion::Fixed => {
-                for j in 0..ne {
+                for j in 0..wanted {
                     let mut shape = vec![0.0; n];
                     for i in 0..ne {
                         shape[HUB_DOF + i] = phi_f[(i, j)];
@@ -154,18 +163,9 @@ impl ModalAnalysis {
             }
             HubMotion::Free => {
                 modes.extend(rigid_modes(model, &mrr));
-                // M̃ = M_ee − M_er M_rr⁻¹ M_re.
-                let llt = mrr
-                    .llt(Side::Lower)
-                    .map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
-                let mut x = mer.transpose().to_owned(); // 6 × ne → M_rr⁻¹ M_re
-                faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-                let corr = &mer * &x;
-                let mt = Mat::from_fn(ne, ne, |i, j| {
-                    mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)])
-                });
-                let (lam, phi) = generalized_symmetric(&kee, &mt)?;
-                for j in 0..ne {
+                let (x, mt) = condensed_mass(&mee, &mer, &mrr)?;
+                let (lam, phi) = solve(&kee, &mt, wanted)?;
+                for j in 0..wanted {
                     let mut shape = vec![0.0; n];
                     for i in 0..ne {
                         shape[HUB_DOF + i] = phi[(i, j)];
@@ -219,6 +219,60 @@ impl ModalAnalysis {
             })
             .collect()
     }
+}
+
+/// The `count` lowest eigenpairs of (K, M): the partial solver when it saves work, the dense
+/// one otherwise.
+fn solve(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
+    if count < k.nrows() {
+        lowest(k, m, count)
+    } else {
+        generalized_symmetric(k, m)
+    }
+}
+
+/// The free hub's elastic pencil: X = M_rr⁻¹ M_re (6 × n_e) and the mass with the hub's
+/// rigid motion condensed out, M̃ = M_ee − M_er M_rr⁻¹ M_re (the hub's momentum equation).
+fn condensed_mass(
+    mee: &Mat<f64>,
+    mer: &Mat<f64>,
+    mrr: &Mat<f64>,
+) -> Result<(Mat<f64>, Mat<f64>), RitzError> {
+    let ne = mee.nrows();
+    let llt = mrr
+        .llt(Side::Lower)
+        .map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
+    let mut x = mer.transpose().to_owned();
+    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
+    let corr = mer * &x;
+    let mt = Mat::from_fn(ne, ne, |i, j| {
+        mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)])
+    });
+    Ok((x, mt))
+}
+
+/// The `count` lowest elastic circular frequencies ω [rad/s] of a model given by its mass
+/// and stiffness matrices (hub's six coordinates first): hub fixed, the pencil (K_ee, M_ee);
+/// hub free, (K_ee, M̃). Eigenvalues only, for the term selection of [`super::refine`].
+pub(crate) fn elastic_frequencies(
+    m: &Mat<f64>,
+    k: &Mat<f64>,
+    motion: HubMotion,
+    count: usize,
+) -> Result<Vec<f64>, RitzError> {
+    let ne = m.nrows() - HUB_DOF;
+    let mee = m.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
+    let kee = k.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
+    let pencil_mass = match motion {
+        HubMotion::Fixed => mee,
+        HubMotion::Free => {
+            let mer = m.submatrix(HUB_DOF, 0, ne, HUB_DOF).to_owned();
+            let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
+            condensed_mass(&mee, &mer, &mrr)?.1
+        }
+    };
+    let (lambda, _) = solve(&kee, &pencil_mass, count.min(ne))?;
+    Ok(lambda.iter().map(|l| l.max(0.0).sqrt()).collect())
 }
 
 /// Sign convention: the largest-magnitude coordinate is positive (deterministic output).

@@ -14,6 +14,7 @@ mod materials;
 mod plates;
 mod raw;
 mod response;
+mod ritz;
 
 pub use budget::{format_bytes, Estimate};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
@@ -37,6 +38,10 @@ pub struct Scenario {
     pub deployment: Option<Deployment>,
     /// The `[response]` settings (defaults when the section is absent).
     pub response: ResponseSettings,
+    /// The automatic term selection and its frequency-error estimate: present when a
+    /// component gives no `terms` or `[ritz] tolerance` is set (then `structure` has the
+    /// chosen counts).
+    pub term_selection: Option<crate::ritz::refine::TermSelection>,
     /// Where each component was written, to locate a failure found after parsing.
     sources: Sources,
 }
@@ -259,19 +264,25 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         basis,
     })
     .map_err(|e| tree_error(cx, &raw, &e))?;
-    let deployment = match &raw.deployment {
-        Some(d) => Some(deployment::lower(cx, d, &structure)?),
-        None => None,
-    };
     let response = match &raw.response {
         Some(r) => response::lower(cx, r)?,
         None => ResponseSettings::default(),
+    };
+    let term_selection = ritz::select(cx, &raw, &structure, response.modes)?;
+    let structure = match &term_selection {
+        Some(sel) => sel.structure.clone(),
+        None => structure,
+    };
+    let deployment = match &raw.deployment {
+        Some(d) => Some(deployment::lower(cx, d, &structure)?),
+        None => None,
     };
     Ok(Scenario {
         name,
         structure,
         deployment,
         response,
+        term_selection,
         sources: sources(cx, &raw),
     })
 }

@@ -156,6 +156,9 @@ pub struct RawMass {
 pub struct RawRitz {
     #[serde(default)]
     pub basis: BasisKind,
+    pub tolerance: Option<S<f64>>,
+    pub modes: Option<S<i64>>,
+    pub max_dof: Option<S<i64>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
