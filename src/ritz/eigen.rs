@@ -196,7 +196,9 @@ pub fn lowest(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat
         }
     }
     let Some((s, llt)) = factored else {
-        let a = Mat::from_fn(n, n, |i, j| k[(i, j)] + shifts[shifts.len() - 1] * m[(i, j)]);
+        let a = Mat::from_fn(n, n, |i, j| {
+            k[(i, j)] + shifts[shifts.len() - 1] * m[(i, j)]
+        });
         return Err(RitzError::MassNotPositiveDefinite {
             pivot: first_bad_pivot(&a),
         });

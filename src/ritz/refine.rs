@@ -21,7 +21,8 @@
 //! family's last two refinements n₀ → n₁ → n₂ with changes d₁, d₂ the rate p solves
 //! d₁/d₂ = (a^p − 1) b^p / (b^p − 1), a = n₁/n₀, b = n₂/n₁ (a Richardson step with the rate
 //! fitted, clamped to [`RATE_MIN`, `RATE_MAX`]), and the remaining error is
-//! e = d₂ / (b^p − 1). With one refinement the slowest rate [`RATE_MIN`] is assumed. Because
+//! e = d₂ / (b^p − 1), times a safety factor [`SAFETY`]. With one refinement the slowest rate
+//! [`RATE_MIN`] is assumed. Because
 //! the frequencies converge from above, the estimate is one-sided: the true ω_k lies in
 //! [ω_k − e_k, ω_k].
 //!
@@ -45,7 +46,11 @@ pub const RATE_MIN: f64 = 1.0;
 /// than any power; early levels often *look* faster than the asymptotic rate, and believing
 /// them under-estimates the error. Capping the rate keeps the estimate on the safe side
 /// (it over-estimates a faster-converging family, which then costs one refinement more).
-pub const RATE_MAX: f64 = 5.0;
+pub const RATE_MAX: f64 = 3.0;
+/// Factor on every family's estimate: on the composite spacecraft of the tests the
+/// coarsest levels (tolerance 1e-3, ~200 coordinates) still under-estimated some modes by up
+/// to 2×, before the rates settle; 1.25 keeps those within a factor 1.6.
+pub const SAFETY: f64 = 1.25;
 /// Growth factor of a refinement.
 pub const GROWTH: f64 = 1.5;
 
@@ -278,6 +283,16 @@ struct Step {
     change: Vec<f64>,
 }
 
+/// The step from count `from` (frequencies `coarse`) to `to` (`fine`).
+fn step(from: usize, to: usize, coarse: &[f64], fine: &[f64]) -> Step {
+    let len = coarse.len().min(fine.len());
+    Step {
+        from,
+        to,
+        change: (0..len).map(|k| coarse[k] - fine[k]).collect(),
+    }
+}
+
 /// The error left in one mode by a family after its last steps (absolute, rad/s).
 fn remaining(steps: &[Step], k: usize) -> f64 {
     let d = |s: &Step| s.change.get(k).map_or(f64::INFINITY, |v| v.max(0.0));
@@ -327,6 +342,10 @@ struct Selector<'a> {
     families: Vec<(Family, bool)>,
     steps: Vec<Vec<Step>>,
     exhausted: Vec<bool>,
+    /// Per family: the round its steps were last measured, the round its count last changed.
+    measured_at: Vec<usize>,
+    refined_at: Vec<usize>,
+    round: usize,
     ceiling: Ceiling,
     omega: Vec<f64>,
     solves: usize,
@@ -376,7 +395,11 @@ impl Selector<'_> {
     fn errors(&self) -> Vec<Vec<f64>> {
         self.steps
             .iter()
-            .map(|s| (0..self.omega.len()).map(|k| remaining(s, k)).collect())
+            .map(|s| {
+                (0..self.omega.len())
+                    .map(|k| SAFETY * remaining(s, k))
+                    .collect()
+            })
             .collect()
     }
 
@@ -412,15 +435,59 @@ impl Selector<'_> {
             self.record(i, n, m, &omega);
             self.structure = st;
             self.omega = omega;
+            self.round += 1;
+            self.refined_at[i] = self.round;
+            self.measured_at[i] = self.round;
             return Ok(true);
         }
         Ok(false)
     }
 
+    /// A family's steps were measured before another family of its component changed
+    /// count: the errors of a plate's two directions are not independent (the width's
+    /// truncation shows only once the length resolves the mode), so they are measured again.
+    fn stale(&self, i: usize) -> bool {
+        let c = self.families[i].0.component();
+        (0..self.families.len()).any(|j| {
+            j != i
+                && self.families[j].0.component() == c
+                && self.refined_at[j] > self.measured_at[i]
+        })
+    }
+
+    /// Measures family `i`'s last two steps afresh at the current counts, from two coarser
+    /// sub-blocks (n₀ → n₁ → n, the others as they are).
+    fn remeasure(&mut self, i: usize) -> Result<(), RitzError> {
+        let f = self.families[i].0;
+        let n2 = f.count(&self.structure);
+        let mut steps = Vec::new();
+        if let Some(n1) = coarser(n2) {
+            let w1 = self.solve_with(f, n1)?;
+            if let Some(n0) = coarser(n1) {
+                let w0 = self.solve_with(f, n0)?;
+                steps.push(step(n0, n1, &w0, &w1));
+            }
+            steps.push(step(n1, n2, &w1, &self.omega));
+        }
+        self.steps[i] = steps;
+        self.measured_at[i] = self.round;
+        Ok(())
+    }
+
+    /// Re-measures every stale family; true if any was.
+    fn refresh(&mut self) -> Result<bool, RitzError> {
+        let stale: Vec<usize> = (0..self.families.len())
+            .filter(|&i| self.stale(i))
+            .collect();
+        for &i in &stale {
+            self.remeasure(i)?;
+        }
+        Ok(!stale.is_empty())
+    }
+
     fn record(&mut self, i: usize, from: usize, to: usize, finer_omega: &[f64]) {
-        let len = self.omega.len().min(finer_omega.len());
-        let change = (0..len).map(|k| self.omega[k] - finer_omega[k]).collect();
-        self.steps[i].push(Step { from, to, change });
+        let s = step(from, to, &self.omega, finer_omega);
+        self.steps[i].push(s);
     }
 
     /// Relative estimate of every wanted mode: Σ over families.
@@ -456,8 +523,9 @@ pub fn select_terms(
         }
     }
     // Enough functions for the wanted modes: grow every automatic family together until the
-    // elastic coordinates number twice the wanted modes (or the size limit stops it).
-    let wanted_dof = HUB_DOF + 2 * accuracy.modes + 8;
+    // elastic coordinates number four times the wanted modes (the first levels are then
+    // closer to the asymptotic rate the estimate assumes), or the size limit stops it.
+    let wanted_dof = HUB_DOF + 4 * accuracy.modes + 20;
     while dof(&st) < wanted_dof {
         let mut next = st.clone();
         for (f, _) in families.iter().filter(|(_, a)| *a) {
@@ -495,6 +563,9 @@ pub fn select_terms(
         families,
         steps: vec![Vec::new(); n],
         exhausted: vec![false; n],
+        measured_at: vec![0; n],
+        refined_at: vec![0; n],
+        round: 0,
         ceiling,
         omega,
         solves: 1,
@@ -502,35 +573,22 @@ pub fn select_terms(
     };
     // Given families: two coarser levels of the same model (sub-blocks, no re-assembly).
     for i in 0..n {
-        let (f, auto) = sel.families[i];
-        if auto {
-            continue;
+        if !sel.families[i].1 {
+            sel.remeasure(i)?;
         }
-        let n2 = f.count(&sel.structure);
-        let Some(n1) = coarser(n2) else { continue };
-        let w1 = sel.solve_with(f, n1)?;
-        if let Some(n0) = coarser(n1) {
-            let w0 = sel.solve_with(f, n0)?;
-            let len = w0.len().min(w1.len());
-            let change = (0..len).map(|k| w0[k] - w1[k]).collect();
-            sel.steps[i].push(Step {
-                from: n0,
-                to: n1,
-                change,
-            });
-        }
-        let len = w1.len().min(sel.omega.len());
-        let change = (0..len).map(|k| w1[k] - sel.omega[k]).collect();
-        sel.steps[i].push(Step {
-            from: n1,
-            to: n2,
-            change,
-        });
     }
+    // Refine until the estimate is below the tolerance with every family measured at the
+    // final counts of its component.
     const MAX_ROUNDS: usize = 500;
     for _ in 0..MAX_ROUNDS {
-        let worst = sel.total().iter().fold(0.0_f64, |a, &b| a.max(b));
-        if worst <= accuracy.tolerance || !sel.refine_worst()? {
+        let worst = |sel: &Selector| sel.total().iter().fold(0.0_f64, |a, &b| a.max(b));
+        if worst(&sel) <= accuracy.tolerance
+            && !(sel.refresh()? && worst(&sel) > accuracy.tolerance)
+        {
+            break;
+        }
+        if !sel.refine_worst()? {
+            sel.refresh()?;
             break;
         }
     }
@@ -566,7 +624,7 @@ mod tests {
     /// then exact: e(n) = n^(−p) sampled at 4, 6, 9.
     #[test]
     fn algebraic_sequences_are_extrapolated_exactly() {
-        for p in [1.5, 2.0, 4.0, 5.0] {
+        for p in [1.5, 2.0, 3.0] {
             let e = |n: f64| n.powf(-p);
             let steps = [
                 Step {
@@ -581,7 +639,11 @@ mod tests {
                 },
             ];
             let r = remaining(&steps, 0);
-            assert!((r / e(9.0) - 1.0).abs() < 1e-9, "p = {p}: {r} vs {}", e(9.0));
+            assert!(
+                (r / e(9.0) - 1.0).abs() < 1e-9,
+                "p = {p}: {r} vs {}",
+                e(9.0)
+            );
         }
     }
 

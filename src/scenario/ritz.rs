@@ -87,8 +87,14 @@ pub(super) fn select(
         modes,
         max_dof,
     };
-    refine::select_terms(structure, &automatic, &accuracy).map(Some).map_err(|e| {
-        let span = raw.ritz.as_ref().map_or(0..0, |r| r.span());
-        cx.invalid(span, "ritz", format!("the automatic term selection failed: {e}"))
-    })
+    refine::select_terms(structure, &automatic, &accuracy)
+        .map(Some)
+        .map_err(|e| {
+            let span = raw.ritz.as_ref().map_or(0..0, |r| r.span());
+            cx.invalid(
+                span,
+                "ritz",
+                format!("the automatic term selection failed: {e}"),
+            )
+        })
 }
