@@ -312,7 +312,7 @@ fn remaining(steps: &[Step], k: usize) -> f64 {
 /// The rate p with (a^p − 1) b^p / (b^p − 1) = d₁/d₂ (increasing in p), by bisection on
 /// [`RATE_MIN`, `RATE_MAX`]; the bounds when the ratio lies outside.
 pub fn fitted_rate(a: f64, b: f64, d1: f64, d2: f64) -> f64 {
-    if !(d2 > 0.0) || !d1.is_finite() || !d2.is_finite() {
+    if d2 <= 0.0 || !d1.is_finite() || !d2.is_finite() {
         return RATE_MIN;
     }
     let target = d1 / d2;
@@ -545,7 +545,7 @@ pub fn select_terms(
         top = st.clone();
         for (f, auto) in &families {
             if *auto {
-                let n = (0..steps).fold(Some(f.count(&st)), |n, _| n.and_then(finer));
+                let n = (0..steps).try_fold(f.count(&st), |n, _| finer(n));
                 f.set(&mut top, n.unwrap_or(MAX_TERMS));
             }
         }
