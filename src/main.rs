@@ -228,8 +228,12 @@ fn run_modes(c: &Common) -> Result<(), ExitCode> {
     let scenario = load(c)?;
     let staged = prepare(out, c.force)?;
     let model = RitzModel::assemble(&scenario.structure);
-    let modes =
-        ModalAnalysis::compute(&model).map_err(|e| numerical_failure(&scenario, &model, &e))?;
+    // With an automatic term selection only the modes it aimed at are solved for (the higher
+    // ones of such a model are not converged to anything).
+    let selection = scenario.term_selection.as_ref();
+    let modes = ModalAnalysis::compute_lowest(&model, selection.map(|s| s.accuracy.modes))
+        .map_err(|e| numerical_failure(&scenario, &model, &e))?
+        .with_selection(selection);
     not_finite(path, flexcraft::finite::check_modes(&modes))?;
     finish(
         json,

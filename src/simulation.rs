@@ -100,7 +100,8 @@ impl Simulation {
             .ok_or(SimulationError::NoDeployment)?;
         let settings = &scenario.response;
         let model = RitzModel::assemble(&scenario.structure);
-        let modes = ModalAnalysis::compute(&model)?;
+        let modes =
+            ModalAnalysis::compute(&model)?.with_selection(scenario.term_selection.as_ref());
         let (coupled, deployment) = deploy::simulate_coupled(&scenario.structure, d)?;
         let mut warnings = Vec::new();
         let handed = hand_over_coupled(&model, &modes, d, &coupled, &deployment, settings.handover);

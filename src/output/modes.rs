@@ -19,6 +19,47 @@ fn shares_json(m: &Mode) -> Value {
     Value::Object(map)
 }
 
+/// The automatic term selection (null without one): what was asked, whether it was
+/// reached, the chosen terms per component and each family's share of the estimate.
+fn selection_json(modes: &ModalAnalysis) -> Value {
+    let Some(sel) = &modes.selection else {
+        return Value::Null;
+    };
+    let st = &sel.structure;
+    let mut terms = Map::new();
+    for f in &sel.families {
+        let name = st.component_name(f.family.component()).to_string();
+        let entry = terms.entry(name).or_insert_with(|| json!({}));
+        entry[f.family.key()] = json!(f.terms);
+        entry["automatic"] = json!(f.automatic);
+    }
+    let families: Vec<Value> = sel
+        .families
+        .iter()
+        .map(|f| {
+            json!({
+                "component": st.component_name(f.family.component()),
+                "family": f.family.key(),
+                "terms": f.terms,
+                "automatic": f.automatic,
+                "frequency_error_estimate": f.error.iter().map(|e| e.is_finite().then_some(*e)).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    json!({
+        "tolerance": sel.accuracy.tolerance,
+        "modes": sel.accuracy.modes,
+        "max_dof": sel.accuracy.max_dof,
+        "dof": sel.dof,
+        "reached": sel.reached,
+        "max_frequency_error_estimate": sel.frequency_error.iter().copied().fold(0.0_f64, f64::max),
+        "eigen_solves": sel.solves,
+        "assemblies": sel.assemblies,
+        "terms": terms,
+        "families": families,
+    })
+}
+
 /// The modes as one JSON object (the `--json` interface and `modes.json`).
 pub fn modes_json(model: &RitzModel, modes: &ModalAnalysis) -> String {
     let st = &model.structure;
@@ -34,6 +75,7 @@ pub fn modes_json(model: &RitzModel, modes: &ModalAnalysis) -> String {
                 "dominant": m.dominant(),
                 "strain_energy_share": shares_json(m),
                 "effective_mass_kg": m.effective_mass,
+                "frequency_error_estimate": m.frequency_error_estimate,
             })
         })
         .collect();
@@ -64,6 +106,7 @@ pub fn modes_json(model: &RitzModel, modes: &ModalAnalysis) -> String {
         "hub_motion": match st.hub.motion { HubMotion::Free => "free", HubMotion::Fixed => "fixed" },
         "dof": modes.dof,
         "total_mass_kg": st.total_mass(),
+        "ritz": selection_json(modes),
         "modes": list,
         "hub_fixed": {
             "directions": DIRECTIONS,
@@ -73,6 +116,33 @@ pub fn modes_json(model: &RitzModel, modes: &ModalAnalysis) -> String {
         },
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// One line on the automatic term selection: tolerance, modes, outcome, chosen terms.
+pub fn selection_line(sel: &crate::ritz::refine::TermSelection) -> String {
+    let st = &sel.structure;
+    let mut parts: Vec<String> = Vec::new();
+    for f in &sel.families {
+        let name = st.component_name(f.family.component());
+        let tag = if f.automatic { "" } else { " (given)" };
+        parts.push(format!("{name} {} {}{tag}", f.family.key(), f.terms));
+    }
+    let worst = sel.frequency_error.iter().copied().fold(0.0_f64, f64::max);
+    format!(
+        "Ritz terms for a relative frequency error ≤ {:.0e} on the first {} elastic modes: {} \
+         (estimated error ≤ {:.1e}, {} coordinates, {} eigen-solves): {}",
+        sel.accuracy.tolerance,
+        sel.accuracy.modes,
+        if sel.reached {
+            "reached"
+        } else {
+            "NOT reached within max_dof"
+        },
+        worst,
+        sel.dof,
+        sel.solves,
+        parts.join(", ")
+    )
 }
 
 /// The terminal table.
@@ -91,6 +161,13 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
         modes.dof,
         st.total_mass()
     );
+    if let Some(sel) = &modes.selection {
+        let _ = writeln!(s, "{}", selection_line(sel));
+    }
+    let estimated = modes
+        .modes
+        .iter()
+        .any(|m| m.frequency_error_estimate.is_some());
     let names: Vec<String> = model
         .elements
         .iter()
@@ -102,6 +179,9 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
         "\n{:>4}  {:<7} {:>12} {:>12}  {:<10}",
         "mode", "kind", "f [Hz]", "ω [rad/s]", "dominant"
     );
+    if estimated {
+        let _ = write!(s, " {:>9}", "est. err");
+    }
     for n in &names {
         let _ = write!(s, " {:>8}", format!("SE {n}"));
     }
@@ -116,6 +196,12 @@ pub fn modes_table(scenario: &Scenario, model: &RitzModel, modes: &ModalAnalysis
             m.omega_rad_s,
             m.dominant()
         );
+        if estimated {
+            let _ = match m.frequency_error_estimate {
+                Some(e) => write!(s, " {:>9.1e}", e),
+                None => write!(s, " {:>9}", "-"),
+            };
+        }
         for n in &names {
             let v = m.share(n);
             match v {
@@ -210,6 +296,13 @@ pub fn write_modes(
         ]
         .map(String::from)
         .to_vec();
+        let estimated = modes
+            .modes
+            .iter()
+            .any(|m| m.frequency_error_estimate.is_some());
+        if estimated {
+            header.push("estimated frequency error [-]".to_string());
+        }
         header.extend(names.iter().map(|n| format!("strain energy share {n} [-]")));
         for d in DIRECTIONS {
             let unit = if d.starts_with('r') { "kg m^2" } else { "kg" };
@@ -222,6 +315,9 @@ pub fn write_modes(
             w.write_field(csv_num(m.frequency_hz()))?;
             w.write_field(csv_num(m.omega_rad_s))?;
             w.write_field(m.dominant())?;
+            if estimated {
+                w.write_field(m.frequency_error_estimate.map_or(String::new(), csv_num))?;
+            }
             for n in &names {
                 w.write_field(csv_num(m.share(n).unwrap_or(0.0)))?;
             }

@@ -369,6 +369,13 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
         st.basis.name(),
         if st.hub.motion == HubMotion::Free { "free" } else { "fixed" }
     );
+    if let Some(sel) = &sim.modes.selection {
+        let _ = writeln!(
+            o,
+            "<p class=\"note\">{}</p>",
+            esc(&super::modes::selection_line(sel))
+        );
+    }
     frequency_table(sim, &mut o);
     if st.hub.motion == HubMotion::Free {
         hub_fixed_table(sim, &mut o);
@@ -393,7 +400,15 @@ fn frequency_table(sim: &Simulation, o: &mut String) {
                 .collect()
         })
         .unwrap_or_default();
+    let estimated = sim
+        .modes
+        .modes
+        .iter()
+        .any(|m| m.frequency_error_estimate.is_some());
     o.push_str("<table id=\"frequencies\"><tr><th>mode</th><th class=\"l\">kind</th><th>f [Hz]</th><th>ω [rad/s]</th><th class=\"l\">dominant</th>");
+    if estimated {
+        o.push_str("<th>est. error [-]</th>");
+    }
     for c in &comps {
         let _ = write!(o, "<th>SE {}</th>", esc(c));
     }
@@ -420,6 +435,14 @@ fn frequency_table(sim: &Simulation, o: &mut String) {
             m.omega_rad_s,
             esc(m.dominant())
         );
+        if estimated {
+            match m.frequency_error_estimate {
+                Some(e) => {
+                    let _ = write!(o, "<td>{e:.1e}</td>");
+                }
+                None => o.push_str("<td>–</td>"),
+            }
+        }
         for c in &comps {
             match m.share(c) {
                 Some(v) => {

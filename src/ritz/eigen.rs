@@ -119,10 +119,11 @@ fn first_bad_pivot(m: &Mat<f64>) -> usize {
 /// Modified Gram–Schmidt in the M inner product, twice ("twice is enough"): the columns of
 /// `y` become M-orthonormal. A column that vanishes against the others is left at zero
 /// length's rounding (the Rayleigh–Ritz step then gives it an arbitrary direction).
-fn m_orthonormalize(m: &Mat<f64>, y: &mut Mat<f64>) {
+/// Returns M·Y, updated alongside Y.
+fn m_orthonormalize(m: &Mat<f64>, y: &mut Mat<f64>) -> Mat<f64> {
     let (n, p) = (y.nrows(), y.ncols());
+    let mut my = m * &*y;
     for _ in 0..2 {
-        let mut my = m * &*y;
         for j in 0..p {
             for i in 0..j {
                 let c: f64 = (0..n).map(|r| y[(r, i)] * my[(r, j)]).sum();
@@ -140,6 +141,7 @@ fn m_orthonormalize(m: &Mat<f64>, y: &mut Mat<f64>) {
             }
         }
     }
+    my
 }
 
 /// Subspace iterations at most in [`lowest`].
@@ -215,14 +217,17 @@ pub fn lowest(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat
         x[(i, j)] += 1.0;
     }
     let mut previous = vec![f64::INFINITY; count];
+    let mut mx = m * &x;
     for _ in 0..LOWEST_MAX_ITERATIONS {
-        let mut y = m * &x;
+        let mut y = mx;
         llt.solve_in_place(y.as_mut());
         // With a small shift the rigid-body directions dominate every column of A⁻¹MX;
-        // M-orthonormalising the block keeps the reduced problem well conditioned.
-        m_orthonormalize(m, &mut y);
-        let kr = y.transpose() * (k * &y);
-        let mr = y.transpose() * (m * &y);
+        // M-orthonormalising the block keeps the reduced problem well conditioned. The
+        // products M·Y and K·Y are formed once per iteration and carried through Z.
+        let my = m_orthonormalize(m, &mut y);
+        let ky = k * &y;
+        let kr = y.transpose() * &ky;
+        let mr = y.transpose() * &my;
         // The reduced problem, shifted like A: with rigid-body modes YᵀKY is singular to
         // rounding, and its inverse route would spread that rounding over every mode.
         let sym = |a: &Mat<f64>, b: &Mat<f64>, c: f64| {
@@ -233,8 +238,8 @@ pub fn lowest(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat
         let (shifted, z) = generalized_symmetric(&sym(&kr, &mr, s), &sym(&mr, &mr, 0.0))?;
         let lambda: Vec<f64> = shifted.iter().map(|l| l - s).collect();
         x = &y * &z;
-        let kx = k * &x;
-        let mx = m * &x;
+        let kx = &ky * &z;
+        mx = &my * &z;
         let scale = lambda[count - 1].abs().max(s);
         let converged = (0..count).all(|j| {
             let (mut r, mut kn, mut mn) = (0.0_f64, 0.0_f64, 0.0_f64);

@@ -36,6 +36,10 @@ pub struct Mode {
     /// Modal effective mass in the hub's six directions [kg, kg, kg, kg·m², kg·m², kg·m²]
     /// (elastic modes of a fixed hub).
     pub effective_mass: Option<[f64; 6]>,
+    /// Estimated relative error of the frequency, (f − f_exact)/f ≥ 0 (the Ritz frequency is
+    /// an upper bound), for the modes an automatic term selection aimed at
+    /// ([`super::refine`]); `None` otherwise.
+    pub frequency_error_estimate: Option<f64>,
 }
 
 impl Mode {
@@ -53,6 +57,7 @@ impl Mode {
             shape,
             strain_energy_share: Vec::new(),
             effective_mass: None,
+            frequency_error_estimate: None,
         }
     }
 
@@ -96,6 +101,8 @@ pub struct ModalAnalysis {
     /// Rigid mass of the appendages (everything not rigidly part of the hub) in the hub's six
     /// directions, about the hub's centre of mass: the limit of the effective-mass sums.
     pub appendage_mass: [f64; 6],
+    /// The automatic term selection the model was built with, if any.
+    pub selection: Option<super::refine::TermSelection>,
 }
 
 /// Effective masses below this fraction of the appendage's mass (or inertia) in their
@@ -191,7 +198,25 @@ impl ModalAnalysis {
             modes,
             hub_fixed,
             appendage_mass,
+            selection: None,
         })
+    }
+
+    /// Attaches a term selection's per-mode error estimates to the elastic modes it aimed at
+    /// (the first `accuracy.modes` elastic modes, in order).
+    pub fn with_selection(mut self, selection: Option<&super::refine::TermSelection>) -> Self {
+        if let Some(sel) = selection {
+            for (m, e) in self
+                .modes
+                .iter_mut()
+                .filter(|m| !m.rigid)
+                .zip(&sel.frequency_error)
+            {
+                m.frequency_error_estimate = Some(*e);
+            }
+            self.selection = Some(sel.clone());
+        }
+        self
     }
 
     /// Elastic modes only.
@@ -300,6 +325,7 @@ fn elastic_mode(lambda: f64, mut shape: Vec<f64>, eff: Option<[f64; 6]>) -> Mode
         shape,
         strain_energy_share: Vec::new(),
         effective_mass: eff,
+        frequency_error_estimate: None,
     }
 }
 
