@@ -44,6 +44,26 @@ fn bench(c: &mut Criterion) {
         let s = seed_with(beam, plate);
         g.bench_function(name, |b| b.iter(|| black_box(solve(black_box(&s)))));
     }
+    // Issue 17's composite: automatic terms (selection + the wanted modes), from the text.
+    let composite = include_str!("../examples/composite.toml");
+    for tol in ["1e-5", "1e-6"] {
+        let text = composite.replace(
+            "tolerance = 1e-5",
+            &format!("tolerance = {tol}\nmax_dof = 3000"),
+        );
+        g.bench_function(
+            format!("composite first 10 to {tol}, automatic terms"),
+            |b| {
+                b.iter(|| {
+                    let s = Scenario::from_toml_str(black_box(&text), "composite.toml")
+                        .expect("composite");
+                    let model = RitzModel::assemble(&s.structure);
+                    let sel = s.term_selection.as_ref().map(|t| t.accuracy.modes);
+                    black_box(ModalAnalysis::compute_lowest(&model, sel).expect("modes"))
+                })
+            },
+        );
+    }
     let s = Scenario::from_toml_str(SEED, "seed.toml").expect("seed");
     g.bench_function("seed default: assembly only", |b| {
         b.iter(|| black_box(RitzModel::assemble(black_box(&s.structure))))

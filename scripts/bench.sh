@@ -28,6 +28,11 @@ best_of 20 ./target/release/flexcraft modes examples/seed.toml
 echo "the same with --out (CSV + 24 plots), one run:"
 best_of 1 ./target/release/flexcraft modes examples/seed.toml --out target/bench-out
 rm -rf target/bench-out
+echo "whole process, flexcraft modes examples/composite.toml (automatic terms, first 10 to 1e-5; best of 5):"
+best_of 5 ./target/release/flexcraft modes examples/composite.toml
+sed 's/^tolerance = 1e-5/tolerance = 1e-6\nmax_dof = 3000/' examples/composite.toml > target/composite-1e-6.toml
+echo "the same to 1e-6 (best of 3):"
+best_of 3 ./target/release/flexcraft modes target/composite-1e-6.toml
 echo "whole process, flexcraft simulate examples/seed.toml (best of 20):"
 best_of 20 ./target/release/flexcraft simulate examples/seed.toml
 echo "the same with --out (CSV, JSON, 11 PNG+SVG plots), best of 5:"

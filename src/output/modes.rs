@@ -270,23 +270,17 @@ pub(crate) fn sample_all(
     out
 }
 
-/// Writes modes.json, frequencies.csv, coefficients/mode_NNN.csv, shapes/mode_NNN.csv and
-/// plots/mode_NNN.{png,svg} (first 12 modes).
-pub fn write_modes(
-    dir: &mut OutputDir,
-    model: &RitzModel,
-    modes: &ModalAnalysis,
-) -> Result<(), OutputError> {
+/// frequencies.csv: one row per mode with its frequency, dominant component, strain-energy
+/// shares, effective masses and (automatic terms) the frequency-error estimate.
+fn frequencies_csv(model: &RitzModel, modes: &ModalAnalysis) -> std::io::Result<Vec<u8>> {
     let st = &model.structure;
-    dir.write("modes.json", modes_json(model, modes) + "\n")?;
-
     let names: Vec<String> = model
         .elements
         .iter()
         .filter(|e| !matches!(e.kind, ElementKind::Rigid))
         .map(|e| st.component_name(e.id).to_string())
         .collect();
-    let f = csv_bytes(|w| {
+    csv_bytes(|w| {
         let mut header: Vec<String> = [
             "mode",
             "rigid",
@@ -327,8 +321,20 @@ pub fn write_modes(
             w.write_record(None::<&[u8]>)?;
         }
         Ok(())
-    })?;
-    dir.write("frequencies.csv", f)?;
+    })
+}
+
+/// Writes modes.json, frequencies.csv, coefficients/mode_NNN.csv, shapes/mode_NNN.csv and
+/// plots/mode_NNN.{png,svg} (first 12 modes).
+pub fn write_modes(
+    dir: &mut OutputDir,
+    model: &RitzModel,
+    modes: &ModalAnalysis,
+) -> Result<(), OutputError> {
+    let st = &model.structure;
+    dir.write("modes.json", modes_json(model, modes) + "\n")?;
+
+    dir.write("frequencies.csv", frequencies_csv(model, modes)?)?;
 
     for m in &modes.modes {
         // Coefficients grouped by component and field: the paper's tables 2.2–2.3.

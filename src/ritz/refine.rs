@@ -1,5 +1,5 @@
 //! Automatic choice of the Ritz term counts for a requested accuracy, with a per-mode error
-//! estimate (docs/theory.md §1.5).
+//! estimate (docs/theory.md §1.4).
 //!
 //! Every elastic component's functions fall into *families* that can be refined on their own:
 //! a beam's bending (v and w together), torsion and axial functions, a plate's functions

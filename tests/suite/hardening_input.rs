@@ -556,3 +556,61 @@ fn latch_keys_are_refused_with_location() {
         assert_refused(&sub, &out, line_of(src, needle), key, reason);
     }
 }
+
+/// `[ritz]` accuracy keys: out-of-range tolerance, mode count and size limit are refused at
+/// their line with exit 2 and nothing written; a size limit too small for the components
+/// with given terms says so.
+#[test]
+fn ritz_accuracy_keys_are_refused_with_location() {
+    let dir = scratch("ritz_keys");
+    let base = include_str!("../../examples/composite.toml");
+    for (from, to, key, reason) in [
+        (
+            "tolerance = 1e-5",
+            "tolerance = 0.5",
+            "ritz.tolerance",
+            "[1e-10, 0.1]",
+        ),
+        (
+            "tolerance = 1e-5",
+            "tolerance = 0.0",
+            "ritz.tolerance",
+            "[1e-10, 0.1]",
+        ),
+        ("modes = 10", "modes = 0", "ritz.modes", "from 1 to 500"),
+        (
+            "modes = 10",
+            "modes = 10\nmax_dof = 5",
+            "ritz.max_dof",
+            "from 7 to 4000",
+        ),
+        (
+            "modes = 10",
+            "modes = 10\nmax_dof = 99999",
+            "ritz.max_dof",
+            "from 7 to 4000",
+        ),
+    ] {
+        let src = base.replacen(from, to, 1);
+        assert!(src != base, "{to}");
+        let out = run(&dir, "modes", &src, &[]);
+        let line = line_of(&src, to.lines().last().unwrap());
+        assert_refused(&dir, &out, line, key, reason);
+    }
+    // Given terms larger than the limit.
+    let src = base
+        .replacen(
+            "bending_stiffness = 6.2e5",
+            "bending_stiffness = 6.2e5\nterms = { length = 40, width = 20 }",
+            1,
+        )
+        .replacen("modes = 10", "modes = 10\nmax_dof = 500", 1);
+    let out = run(&dir, "modes", &src, &[]);
+    assert_refused(
+        &dir,
+        &out,
+        line_of(&src, "max_dof = 500"),
+        "ritz.max_dof",
+        "already have 806 coordinates",
+    );
+}
