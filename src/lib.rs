@@ -128,6 +128,7 @@
 
 pub mod basis;
 pub mod deploy;
+pub mod export;
 pub mod finite;
 pub mod limits;
 pub mod math;

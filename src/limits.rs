@@ -198,6 +198,14 @@ pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
 pub const DURATION: Limit = closed(1e-6, 1e6, "s");
 /// Modal damping ratio of the response, [0, 1): an underdamped structure.
 pub const DAMPING_RATIO: Limit = closed_open(0.0, 1.0, "");
+/// `[export] frequency_range` of the frequency response.
+pub const EXPORT_FREQUENCY: Limit = closed(1e-6, 1e7, "Hz");
+/// `[export] frequency_points`: most log-spaced frequencies of the response.
+pub const MAX_FREQUENCY_POINTS: usize = 100_000;
+/// `[export] modes`: most kept elastic modes (the model's own count bounds it too).
+pub const MAX_EXPORT_MODES: usize = MAX_RITZ_DOF;
+/// `[[export.points]]`: most named points.
+pub const MAX_EXPORT_POINTS: usize = 1000;
 /// Output sample rates.
 pub const OUTPUT_RATE: Limit = closed(1e-3, 1e5, "Hz");
 

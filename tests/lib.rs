@@ -15,6 +15,7 @@ mod suite {
     pub mod deploy;
     pub mod deploy_maximal;
     pub mod exact_beams;
+    pub mod export;
     pub mod hardening_input;
     pub mod hardening_output;
     pub mod modal_properties;

@@ -78,13 +78,22 @@ impl Mode {
     }
 }
 
-/// An elastic mode of the hub-fixed system with its effective masses.
+/// An elastic mode of the hub-fixed system (the hub held: the structure's fixed-interface
+/// modes) with its participation in the hub's six rigid motions.
 #[derive(Debug, Clone)]
 pub struct HubFixedMode {
     /// ω, rad/s.
     pub omega_rad_s: f64,
-    /// Effective masses, hub directions [x, y, z, rx, ry, rz].
+    /// Effective masses, hub directions [x, y, z, rx, ry, rz]: L_d² (rounding below
+    /// [`EFFECTIVE_MASS_FLOOR`] of the appendage's mass in that direction reads 0).
     pub effective_mass: [f64; 6],
+    /// Signed modal participation L_d = φᵀ M_{e,d} (kg^½ for the translations, kg^½·m for
+    /// the rotations): the coupling of the mass-normalised mode φ with the hub's rigid motion
+    /// d (translation of the hub's centre of mass, rotation about it, structure frame).
+    pub participation: [f64; 6],
+    /// The mode shape over all coordinates (the hub's six are zero), mass-normalised
+    /// (φᵀ M φ = 1), signed so that its largest coordinate is positive.
+    pub shape: Vec<f64>,
 }
 
 /// The result of a modal analysis.
@@ -134,9 +143,16 @@ impl ModalAnalysis {
         let appendage_mass = appendage_mass(model, &mrr);
         let hub_fixed: Vec<HubFixedMode> = (0..wanted)
             .map(|j| {
+                let mut shape = vec![0.0; n];
+                for i in 0..ne {
+                    shape[HUB_DOF + i] = phi_f[(i, j)];
+                }
+                fix_sign(&mut shape);
                 let mut eff = [0.0; 6];
+                let mut participation = [0.0; 6];
                 for (d, e) in eff.iter_mut().enumerate() {
-                    let l: f64 = (0..ne).map(|i| phi_f[(i, j)] * mer[(i, d)]).sum();
+                    let l: f64 = (0..ne).map(|i| shape[HUB_DOF + i] * mer[(i, d)]).sum();
+                    participation[d] = l;
                     // Below EFFECTIVE_MASS_FLOOR of the appendage's mass in that direction
                     // the value is rounding (a mode that cannot move that way): exact zero.
                     *e = if l * l <= EFFECTIVE_MASS_FLOOR * appendage_mass[d] {
@@ -148,6 +164,8 @@ impl ModalAnalysis {
                 HubFixedMode {
                     omega_rad_s: lam_f[j].max(0.0).sqrt(),
                     effective_mass: eff,
+                    participation,
+                    shape,
                 }
             })
             .collect();
@@ -156,15 +174,11 @@ impl ModalAnalysis {
         let motion = model.structure.hub.motion;
         match motion {
             HubMotion::Fixed => {
-                for j in 0..wanted {
-                    let mut shape = vec![0.0; n];
-                    for i in 0..ne {
-                        shape[HUB_DOF + i] = phi_f[(i, j)];
-                    }
+                for (j, h) in hub_fixed.iter().enumerate() {
                     modes.push(elastic_mode(
                         lam_f[j],
-                        shape,
-                        Some(hub_fixed[j].effective_mass),
+                        h.shape.clone(),
+                        Some(h.effective_mass),
                     ));
                 }
             }

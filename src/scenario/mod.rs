@@ -8,6 +8,7 @@ mod budget;
 mod context;
 mod deployment;
 mod error;
+mod export;
 mod hub;
 mod masses;
 mod materials;
@@ -38,6 +39,8 @@ pub struct Scenario {
     pub deployment: Option<Deployment>,
     /// The `[response]` settings (defaults when the section is absent).
     pub response: ResponseSettings,
+    /// The `[export]` settings (defaults when the section is absent).
+    pub export: crate::export::ExportSettings,
     /// The automatic term selection and its frequency-error estimate: present when a
     /// component gives no `terms` or `[ritz] tolerance` is set (then `structure` has the
     /// chosen counts).
@@ -81,6 +84,15 @@ impl Scenario {
     /// without reading the file a second time).
     pub fn source_text(&self) -> &str {
         &self.sources.text
+    }
+
+    /// The elastic modes the export keeps: `[export] modes` (or the damping list's length);
+    /// with automatic terms and neither given, the modes the selection aimed at (the higher
+    /// ones of such a model are not converged); otherwise every mode of the model (`None`).
+    pub fn export_modes(&self) -> Option<usize> {
+        self.export
+            .modes
+            .or(self.term_selection.as_ref().map(|s| s.accuracy.modes))
     }
 
     /// Like [`Scenario::locate`], for one of the keys the run checks after parsing.
@@ -268,7 +280,19 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(r) => response::lower(cx, r)?,
         None => ResponseSettings::default(),
     };
-    let term_selection = ritz::select(cx, &raw, &structure, response.modes)?;
+    let export = match &raw.export {
+        Some(e) => export::lower(cx, e, &structure)?,
+        None => crate::export::ExportSettings {
+            transfers: crate::export::default_transfers(structure.hub().motion(), &[]),
+            ..Default::default()
+        },
+    };
+    // The automatic terms aim at the modes the run uses: the response's or the export's.
+    let used_modes = match (response.modes, export.modes) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    };
+    let term_selection = ritz::select(cx, &raw, &structure, used_modes)?;
     let structure = match &term_selection {
         Some(sel) => sel.structure.clone(),
         None => structure,
@@ -282,6 +306,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         structure,
         deployment,
         response,
+        export,
         term_selection,
         sources: sources(cx, &raw),
     })

@@ -25,6 +25,7 @@ pub struct RawScenario {
     pub ritz: Option<S<RawRitz>>,
     pub deployment: Option<S<RawDeployment>>,
     pub response: Option<S<RawResponse>>,
+    pub export: Option<S<RawExport>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -273,4 +274,43 @@ pub struct RawResponse {
     pub modes: Option<S<i64>>,
     pub damping_ratio: Option<S<f64>>,
     pub handover: Option<S<RawHandover>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawExport {
+    pub modes: Option<S<i64>>,
+    pub damping_ratio: Option<S<RawDamping>>,
+    #[serde(default)]
+    pub points: Vec<S<RawPoint>>,
+    #[serde(default)]
+    pub transfer: Vec<S<RawTransfer>>,
+    pub frequency_range: Option<S<Vec<f64>>>,
+    pub frequency_points: Option<S<i64>>,
+}
+
+/// One ratio for every mode, or a list with one per kept mode.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+pub enum RawDamping {
+    One(f64),
+    List(Vec<f64>),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPoint {
+    pub name: S<String>,
+    pub component: S<String>,
+    pub station: Option<S<f64>>,
+    pub xi: Option<S<f64>>,
+    pub eta: Option<S<f64>>,
+    pub position: Option<S<[f64; 3]>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawTransfer {
+    pub input: S<String>,
+    pub output: S<String>,
 }

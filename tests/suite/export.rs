@@ -1,0 +1,375 @@
+//! The exported linear model (`flexcraft export`): its frequency response against a direct
+//! solve of the full Ritz model, its rigid-body asymptotes against the structure's own mass
+//! properties, the eigenvalues of A, and the participation's completeness against the
+//! published effective masses of a cantilever.
+
+use super::common::scenario;
+use faer::linalg::solvers::Solve;
+use faer::Mat;
+use flexcraft::export::{point_jacobian, ExportModel, ExportSettings, PointLocation};
+use flexcraft::{ModalAnalysis, RitzModel};
+
+/// A free hub (CM off the reference point), a tube boom, a plate at the boom's tip and a
+/// lumped mass on the boom; points on every kind of component.
+fn spacecraft(motion: &str, extra: &str) -> String {
+    format!(
+        r#"
+name = "export test"
+[hub]
+motion = "{motion}"
+mass = 300.0
+inertia = [120.0, 150.0, 90.0, 4.0, -3.0, 2.0]
+center_of_mass = [0.1, -0.2, -0.4]
+[materials.al]
+youngs_modulus = 70e9
+poisson_ratio = 0.3
+density = 2700.0
+[[beams]]
+name = "boom"
+parent = "hub"
+root = [0.3, 0.0, 0.5]
+axis = [0.0, 0.2, 1.0]
+length = 4.0
+material = "al"
+section = {{ tube = {{ outer_diameter = 0.08, wall = 0.003 }} }}
+terms = {{ bending = 6, torsion = 4, axial = 3 }}
+[[plates]]
+name = "wing"
+parent = "boom"
+station = 4.0
+length_axis = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+length = 3.0
+width = 1.2
+areal_density = 4.0
+bending_stiffness = 2.0e3
+poisson_ratio = 0.3
+terms = {{ length = 5, width = 3 }}
+[[masses]]
+name = "box"
+parent = "boom"
+station = 2.5
+offset = [0.1, 0.05, 0.0]
+mass = 12.0
+inertia = [0.3, 0.2, 0.25]
+[export]
+{extra}
+[[export.points]]
+name = "tip"
+component = "boom"
+station = 4.0
+[[export.points]]
+name = "corner"
+component = "wing"
+xi = 1.0
+eta = 0.0
+[[export.points]]
+name = "payload"
+component = "box"
+[[export.points]]
+name = "sensor"
+component = "hub"
+position = [0.5, 0.5, -0.3]
+"#
+    )
+}
+
+fn build(toml: &str) -> (RitzModel, ModalAnalysis, ExportModel, ExportSettings) {
+    let s = scenario(toml);
+    let model = RitzModel::assemble(&s.structure);
+    let modes = ModalAnalysis::compute_lowest(&model, s.export_modes()).expect("modes");
+    let ex = ExportModel::build(&model, &modes, &s.export).expect("export");
+    (model, modes, ex, s.export)
+}
+
+/// H(iω) of every input/output pair by a direct solve of (K − ω²M + iωC_q) q = B_q u on the
+/// full Ritz model, with C_q = M Φ diag(2ζω) Φᵀ M (modal damping in physical coordinates),
+/// in real block form [[K − ω²M, −ωC], [ωC, K − ω²M]] [qr; qi] = [b; 0].
+fn direct_response(
+    model: &RitzModel,
+    modes: &ModalAnalysis,
+    zeta: f64,
+    sites: &[PointLocation],
+    omega: f64,
+) -> Vec<Vec<(f64, f64)>> {
+    // A fixed hub holds its six coordinates: the direct solve keeps the elastic ones only.
+    let h = match modes.hub_motion {
+        flexcraft::structure::HubMotion::Free => 0,
+        flexcraft::structure::HubMotion::Fixed => 6,
+    };
+    let n = model.dof() - h;
+    let m = model.mass.submatrix(h, h, n, n).to_owned();
+    let k = model.stiffness.submatrix(h, h, n, n).to_owned();
+    let phi = Mat::from_fn(n, modes.modes.len(), |i, j| modes.modes[j].shape[h + i]);
+    let z = Mat::from_fn(modes.modes.len(), modes.modes.len(), |i, j| {
+        let md = &modes.modes[i];
+        if i == j && !md.rigid {
+            2.0 * zeta * md.omega_rad_s
+        } else {
+            0.0
+        }
+    });
+    let mp = &m * &phi;
+    let c = &mp * &z * mp.transpose();
+    let dyn_k = Mat::from_fn(n, n, |i, j| k[(i, j)] - omega * omega * m[(i, j)]);
+    let big = Mat::from_fn(2 * n, 2 * n, |i, j| match (i < n, j < n) {
+        (true, true) => dyn_k[(i, j)],
+        (true, false) => -omega * c[(i, j - n)],
+        (false, true) => omega * c[(i - n, j)],
+        (false, false) => dyn_k[(i - n, j - n)],
+    });
+    let lu = big.partial_piv_lu();
+    let jac: Vec<Vec<[f64; 6]>> = sites.iter().map(|s| point_jacobian(model, s)).collect();
+    let ni = 6 * sites.len();
+    let rhs = Mat::from_fn(2 * n, ni, |r, col| {
+        if r < n {
+            jac[col / 6][h + r][col % 6]
+        } else {
+            0.0
+        }
+    });
+    let q = lu.solve(&rhs);
+    // Outputs: every site's six displacement components (the velocity ones are iω times).
+    (0..ni)
+        .map(|o| {
+            (0..ni)
+                .map(|i| {
+                    let (mut re, mut im) = (0.0, 0.0);
+                    for r in 0..n {
+                        let jr = jac[o / 6][h + r][o % 6];
+                        re += jr * q[(r, i)];
+                        im += jr * q[(n + r, i)];
+                    }
+                    (re, im)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Row of output `o`'s displacement of site s, component c, in the export's output list.
+fn displacement_row(site: usize, c: usize) -> usize {
+    if site == 0 {
+        c
+    } else {
+        12 + 9 * (site - 1) + c
+    }
+}
+
+fn check_against_direct(motion: &str) {
+    let zeta = 0.02;
+    let (model, _, ex, settings) = build(&spacecraft(motion, &format!("damping_ratio = {zeta}")));
+    // Every mode kept: the modal sum is exact.
+    let all = ModalAnalysis::compute(&model).expect("modes");
+    assert_eq!(ex.modes.len(), all.modes.len());
+    let sites: Vec<PointLocation> = std::iter::once(PointLocation::Hub {
+        position: flexcraft::math::Vec3::ZERO,
+    })
+    .chain(settings.points.iter().map(|p| p.location))
+    .collect();
+    let w1 = ex
+        .modes
+        .iter()
+        .find(|m| !m.rigid)
+        .expect("elastic")
+        .omega_rad_s;
+    for omega in [0.37 * w1, 1.3 * w1, 7.9 * w1, 55.0 * w1] {
+        let direct = direct_response(&model, &all, zeta, &sites, omega);
+        let mut scale: f64 = 0.0;
+        for row in &direct {
+            for (re, im) in row {
+                scale = scale.max(re.hypot(*im));
+            }
+        }
+        for o in 0..6 * sites.len() {
+            for i in 0..6 * sites.len() {
+                let h = ex.transfer(displacement_row(o / 6, o % 6), i, omega);
+                let (re, im) = direct[o][i];
+                let err = (h.re - re).hypot(h.im - im);
+                assert!(
+                    err <= 1e-9 * scale,
+                    "{motion} ω = {omega}: {} → {}: modal {h} vs direct {re}+{im}i",
+                    ex.input_names[i],
+                    ex.output_names[displacement_row(o / 6, o % 6)]
+                );
+                // Velocity outputs are iω times the displacement ones.
+                if o / 6 == 0 || o % 6 < 3 {
+                    let vrow = if o / 6 == 0 {
+                        6 + o
+                    } else {
+                        displacement_row(o / 6, o % 6) + 6
+                    };
+                    let hv = ex.transfer(vrow, i, omega);
+                    let err = (hv.re + omega * im).hypot(hv.im - omega * re);
+                    assert!(
+                        err <= 1e-9 * scale * omega,
+                        "velocity {}",
+                        ex.output_names[vrow]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn frequency_response_equals_a_direct_solve_of_the_full_ritz_model() {
+    check_against_direct("free");
+    check_against_direct("fixed");
+}
+
+/// At low frequency the free structure responds as a rigid body: −ω² H(hub wrench → hub
+/// motion) → M_O⁻¹, the inverse of the whole structure's rigid mass about the hub's
+/// reference point, computed here from the components' own mass properties
+/// ([`flexcraft::structure::Structure::rigid_body`]), not from the Ritz mass matrix. Its
+/// force → position block along a principal direction is 1/m_total only at the CM; the
+/// torque → attitude block is the inverse inertia about the system CM.
+#[test]
+fn low_frequency_asymptote_is_the_inverse_rigid_mass() {
+    let (_, _, ex, _) = build(&spacecraft("free", "modes = 8"));
+    let body = scenario(&spacecraft("free", "modes = 8"))
+        .structure
+        .rigid_body();
+    // structure.rigid_body() is about the structure frame's origin: the hub's reference point.
+    let m6 = body.block();
+    let mref = Mat::from_fn(6, 6, |i, j| m6[i][j]);
+    let inv = mref.partial_piv_lu().solve(Mat::<f64>::identity(6, 6));
+    let w1 = ex
+        .modes
+        .iter()
+        .find(|m| !m.rigid)
+        .expect("elastic")
+        .omega_rad_s;
+    let omega = 1e-4 * w1;
+    for o in 0..6 {
+        for i in 0..6 {
+            let h = ex.transfer(o, i, omega);
+            let got = -omega * omega * h.re;
+            let want = inv[(o, i)];
+            assert!(
+                (got - want).abs() <= 1e-6 * inv[(o, o)].abs().max(inv[(i, i)].abs()),
+                "{} → {}: {got} vs {want}",
+                ex.input_names[i],
+                ex.output_names[o]
+            );
+        }
+    }
+    // Torque → attitude: the inverse inertia about the system CM.
+    let jcm = body.inertia_at_cm();
+    let j = Mat::from_fn(3, 3, |a, b| jcm.get(a, b));
+    let jinv = j.partial_piv_lu().solve(Mat::<f64>::identity(3, 3));
+    for a in 0..3 {
+        for b in 0..3 {
+            assert!((inv[(3 + a, 3 + b)] - jinv[(a, b)]).abs() <= 1e-12 * jinv[(a, a)]);
+        }
+    }
+    assert!((ex.total_mass - body.mass).abs() <= 1e-12 * body.mass);
+    assert!((ex.center_of_mass - body.center_of_mass()).norm() <= 1e-12);
+}
+
+/// The eigenvalues of A are −ζω ± iω√(1 − ζ²) for every kept elastic mode and pairs of
+/// zeros for the rigid modes (faer's general eigen-solver, not the construction).
+#[test]
+fn eigenvalues_of_a_are_the_damped_modal_poles() {
+    let zetas = "[0.01, 0.02, 0.03, 0.05, 0.1, 0.2]";
+    let (_, _, ex, _) = build(&spacecraft("free", &format!("damping_ratio = {zetas}")));
+    assert_eq!(ex.modes.iter().filter(|m| !m.rigid).count(), 6);
+    let ss = ex.first_order();
+    let ev = ss.a.eigenvalues().expect("eigenvalues");
+    let mut want: Vec<(f64, f64)> = Vec::new();
+    for m in &ex.modes {
+        let (w, z) = (m.omega_rad_s, m.damping_ratio);
+        let wd = w * (1.0 - z * z).sqrt();
+        want.push((-z * w, wd));
+        want.push((-z * w, -wd));
+    }
+    let wmax = ex.modes.iter().map(|m| m.omega_rad_s).fold(0.0, f64::max);
+    for (re, im) in want {
+        let best = ev
+            .iter()
+            .map(|e| (e.re - re).hypot(e.im - im))
+            .fold(f64::INFINITY, f64::min);
+        // Zero poles are a defective (Jordan) pair: their computed values scatter by √ε.
+        let tol = if re == 0.0 && im == 0.0 {
+            1e-6 * wmax
+        } else {
+            1e-9 * wmax
+        };
+        assert!(best <= tol, "pole {re}{im:+}i: nearest computed at {best}");
+    }
+}
+
+/// A slender cantilever on a fixed hub: the effective-mass fractions of its first bending
+/// modes are the Euler–Bernoulli cantilever's 0.6131, 0.1883, 0.0647 (closed form below),
+/// and the participation's Σ L Lᵀ is the projection the Müntz distance formula gives.
+#[test]
+fn participation_reproduces_the_cantilever_effective_masses() {
+    let toml = r#"
+name = "cantilever"
+[hub]
+motion = "fixed"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[materials.steel]
+youngs_modulus = 210e9
+poisson_ratio = 0.3
+density = 7850.0
+[[beams]]
+name = "boom"
+parent = "hub"
+root = [0.0, 0.0, 0.0]
+axis = [1.0, 0.0, 0.0]
+length = 3.0
+material = "steel"
+section = { tube = { outer_diameter = 0.05, wall = 0.002 } }
+terms = { bending = 16, torsion = 4, axial = 4 }
+"#;
+    let (_, modes, ex, _) = build(toml);
+    let beam_mass =
+        7850.0 * std::f64::consts::PI / 4.0 * (0.05f64.powi(2) - 0.046f64.powi(2)) * 3.0;
+    // Closed form: β_j L are the roots of 1 + cos βL cosh βL = 0 and the effective-mass
+    // fraction of mode j is 4 σ_j² / (β_j L)², σ_j = (sinh − sin)/(cosh + cos) at β_j L.
+    let beta_l = [1.875104068711961, 4.694091132974175, 7.854757438237613];
+    let frac: Vec<f64> = beta_l
+        .iter()
+        .map(|&b: &f64| {
+            let sigma = (b.sinh() - b.sin()) / (b.cosh() + b.cos());
+            4.0 * sigma * sigma / (b * b)
+        })
+        .collect();
+    assert!((frac[0] - 0.6131).abs() < 1e-4 && (frac[1] - 0.1883).abs() < 1e-4);
+    // Bending in y (direction 1) and z (direction 2): hub-fixed modes come in pairs.
+    let mut got_y: Vec<f64> = (0..ex.hub_fixed_omega.len())
+        .map(|j| ex.effective_mass[(1, j)] / beam_mass)
+        .filter(|f| *f > 1e-3)
+        .collect();
+    got_y.truncate(3);
+    for (g, w) in got_y.iter().zip(&frac) {
+        assert!((g - w).abs() <= 1e-6, "effective mass fraction {g} vs {w}");
+    }
+    // Completeness: Σ_j L_j L_jᵀ over all N bending modes is the mass-weighted projection of
+    // the rigid translation onto the clamped bending basis, whose span is {x², …, x^(N+1)}
+    // (polynomial basis). By the Müntz/Cauchy-determinant distance formula, the L²(0, 1)
+    // distance of 1 from span{x^λ_k} is Π λ_k/(λ_k + 1) (Borwein & Erdélyi, "Polynomials and
+    // Polynomial Inequalities", Springer 1995, §4.2), which telescopes here to 2/(N + 2): the
+    // reported fraction is exactly 1 − (2/(N + 2))².
+    let nf = ex.hub_fixed_omega.len();
+    let sum_yy: f64 = (0..nf).map(|j| ex.participation[(1, j)].powi(2)).sum();
+    let want = 1.0 - (2.0f64 / 18.0).powi(2);
+    assert!(
+        (sum_yy / modes.appendage_mass[1] - want).abs() <= 1e-10,
+        "completeness {} vs {want}",
+        sum_yy / modes.appendage_mass[1]
+    );
+    let last = ex.effective_mass_fraction[(1, nf - 1)];
+    assert!((last - want).abs() <= 1e-10, "reported fraction {last}");
+    // The signed participation squares to the effective mass.
+    for j in 0..nf {
+        for d in 0..6 {
+            let l = ex.participation[(d, j)];
+            let e = ex.effective_mass[(d, j)];
+            assert!(e == 0.0 || (l * l - e).abs() <= 1e-12 * e);
+        }
+    }
+}
