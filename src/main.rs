@@ -54,6 +54,13 @@ enum Command {
     /// plots.
     #[command(after_help = UNITS)]
     Deploy(#[command(flatten)] Common),
+    /// The linear model for control design: modal data, rigid-body mass, participation,
+    /// second-order (mechss) and first-order (A, B, C, D) forms with named inputs and
+    /// outputs ([export] in the scenario; docs/export.md), and the frequency response.
+    /// --out writes model.json, model.npz, model.mat, NASA 42's flex_NAME.txt and
+    /// nodes_NAME.txt, frequency_response.csv and plots/bode.{png,svg}.
+    #[command(after_help = UNITS)]
+    Export(#[command(flatten)] Common),
     /// The whole story: modes of the deployed spacecraft, deployment of the array, hand-over
     /// at the final latch and the latch-excited vibration, hub drift and attitude motion.
     /// --out writes report.html (one self-contained page), summary.json, modes.json,
@@ -76,6 +83,7 @@ fn main() -> ExitCode {
     let done = match cli.command {
         Command::Modes(c) => run_modes(&c),
         Command::Deploy(c) => run_deploy(&c),
+        Command::Export(c) => run_export(&c),
         Command::Simulate {
             common,
             open,
@@ -241,6 +249,51 @@ fn run_modes(c: &Common) -> Result<(), ExitCode> {
         || output::modes_table(&scenario, &model, &modes),
         staged.zip(out),
         |d| output::write_modes(d, &model, &modes),
+    )
+}
+
+fn run_export(c: &Common) -> Result<(), ExitCode> {
+    use flexcraft::export::ExportModel;
+    let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
+    let scenario = load(c)?;
+    let staged = prepare(out, c.force)?;
+    let model = RitzModel::assemble(&scenario.structure);
+    let wanted = scenario.export_modes();
+    let selection = scenario.term_selection.as_ref();
+    let modes = ModalAnalysis::compute_lowest(&model, wanted)
+        .map_err(|e| numerical_failure(&scenario, &model, &e))?
+        .with_selection(selection);
+    not_finite(path, flexcraft::finite::check_modes(&modes))?;
+    let available = modes.elastic().count();
+    if let Some(w) = wanted.filter(|w| *w > available) {
+        eprintln!(
+            "warning: {}: export.modes: {w} elastic modes asked for, the model has {available}; \
+             all {available} are kept",
+            path.display()
+        );
+    }
+    let settings = &scenario.export;
+    let ex = ExportModel::build(&model, &modes, settings).map_err(|e| {
+        eprintln!("error: {}", scenario.refuse_export_damping(e.to_string()));
+        ExitCode::from(REFUSED)
+    })?;
+    let st = &scenario.structure;
+    finish(
+        json,
+        || output::export_json(st, &modes, &ex, &settings.transfers),
+        || output::export_table(st, &ex, &settings.transfers),
+        staged.zip(out),
+        |d| {
+            output::write_export(
+                d,
+                st,
+                &modes,
+                &ex,
+                &settings.transfers,
+                settings.frequency_range_hz,
+                settings.frequency_points,
+            )
+        },
     )
 }
 

@@ -139,12 +139,22 @@ pub fn output_names(points: &[NamedPoint]) -> Vec<String> {
 pub fn channel_unit(name: &str) -> &'static str {
     match name.rsplit('.').next().unwrap_or("") {
         "fx" | "fy" | "fz" => "N",
-        "tx" | "ty" | "tz" => "N m",
+        "tx" | "ty" | "tz" => "N·m",
         "x" | "y" | "z" | "ux" | "uy" | "uz" => "m",
         "rx" | "ry" | "rz" => "rad",
         "vx" | "vy" | "vz" => "m/s",
         "wx" | "wy" | "wz" => "rad/s",
         _ => "",
+    }
+}
+
+/// The unit of a transfer function from `input` to `output`, e.g. `rad/(N·m)`.
+pub fn transfer_unit(input: &str, output: &str) -> String {
+    let i = channel_unit(input);
+    if i.contains('·') {
+        format!("{}/({i})", channel_unit(output))
+    } else {
+        format!("{}/{i}", channel_unit(output))
     }
 }
 

@@ -3,6 +3,7 @@
 
 mod atomic;
 mod deploy;
+mod export;
 pub(crate) mod figures;
 mod modes;
 mod names;
@@ -16,6 +17,7 @@ pub(crate) mod view3d;
 
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, write_deploy};
+pub use export::{export_json, export_table, write_export};
 pub use modes::{modes_json, modes_table, write_modes};
 pub use names::file_stems;
 pub use report::report_html;

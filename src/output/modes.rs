@@ -21,7 +21,7 @@ fn shares_json(m: &Mode) -> Value {
 
 /// The automatic term selection (null without one): what was asked, whether it was
 /// reached, the chosen terms per component and each family's share of the estimate.
-fn selection_json(modes: &ModalAnalysis) -> Value {
+pub(crate) fn selection_json(modes: &ModalAnalysis) -> Value {
     let Some(sel) = &modes.selection else {
         return Value::Null;
     };

@@ -492,3 +492,125 @@ pub fn line_chart_marked(
     );
     Ok(())
 }
+
+/// A tick label of a logarithmic axis: a plain decimal between 10⁻³ and 10⁴, else
+/// scientific.
+fn log_tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".to_string()
+    } else if (1e-3..1e4).contains(&a) {
+        let s = format!("{v:.3}");
+        let s = s.trim_end_matches('0').trim_end_matches('.');
+        s.to_string()
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
+/// One Bode curve: its label and H(f) at frequencies f [Hz].
+pub type BodeCurve = (String, Vec<(f64, faer::c64)>);
+
+/// plots/STEM.png and .svg: a Bode plot, magnitude (log–log) above phase (degrees, log
+/// frequency), one colour per transfer function.
+pub fn bode_chart(
+    dir: &mut OutputDir,
+    stem: &str,
+    title: &str,
+    curves: &[BodeCurve],
+) -> Result<(), OutputError> {
+    register_font();
+    png_and_svg!(dir, format!("plots/{stem}"), (1000, 800), |root| draw_bode(
+        root, title, curves
+    ));
+    Ok(())
+}
+
+fn draw_bode<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    curves: &[BodeCurve],
+) -> Result<(), String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let (w, _) = root.dim_in_pixel();
+    let legend_w = 300.min(w / 3);
+    let (plots, legend) = root.split_horizontally(w - legend_w);
+    let (top, bottom) = plots.split_vertically(400);
+    let pts = || curves.iter().flat_map(|c| c.1.iter());
+    let (mut f0, mut f1, mut m0, mut m1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (f, h) in pts() {
+        let m = h.norm();
+        if f.is_finite() && *f > 0.0 && m.is_finite() && m > 0.0 {
+            (f0, f1) = (f0.min(*f), f1.max(*f));
+            (m0, m1) = (m0.min(m), m1.max(m));
+        }
+    }
+    if f0 >= f1 {
+        (f0, f1) = (0.1, 10.0);
+    }
+    if m0 >= m1 {
+        (m0, m1) = (m0.min(1.0) * 0.5, m0.max(1.0) * 2.0);
+    }
+    let mut mag = ChartBuilder::on(&top)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(36)
+        .y_label_area_size(76)
+        .build_cartesian_2d((f0..f1).log_scale(), (m0 / 1.5..m1 * 1.5).log_scale())
+        .map_err(|e| e.to_string())?;
+    mag.configure_mesh()
+        .y_desc("|H| (output unit / input unit)")
+        .x_label_formatter(&|v| log_tick_label(*v))
+        .y_label_formatter(&|v| log_tick_label(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let mut phase = ChartBuilder::on(&bottom)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(76)
+        .build_cartesian_2d((f0..f1).log_scale(), -190.0..190.0)
+        .map_err(|e| e.to_string())?;
+    phase
+        .configure_mesh()
+        .x_desc("frequency [Hz]")
+        .y_desc("phase [deg]")
+        .x_label_formatter(&|v| log_tick_label(*v))
+        .y_label_formatter(&|v| format!("{v:.0}"))
+        .y_labels(9)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 15))
+        .light_line_style(WHITE.mix(0.0))
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()
+        .map_err(|e| e.to_string())?;
+    for (i, (_, c)) in curves.iter().enumerate() {
+        let color = PALETTE[i % PALETTE.len()];
+        let good = c.iter().filter(|(f, h)| *f > 0.0 && h.norm() > 0.0);
+        mag.draw_series(LineSeries::new(
+            good.clone().map(|(f, h)| (*f, h.norm())),
+            color.stroke_width(2),
+        ))
+        .map_err(|e| e.to_string())?;
+        // Phase wrapped to (−180°, 180°]: a jump of the wrap starts a new segment.
+        let mut seg: Vec<(f64, f64)> = Vec::new();
+        for (f, h) in good {
+            let p = h.arg().to_degrees();
+            if seg.last().is_some_and(|l| (l.1 - p).abs() > 180.0) {
+                phase
+                    .draw_series(LineSeries::new(seg.drain(..), color.stroke_width(2)))
+                    .map_err(|e| e.to_string())?;
+            }
+            seg.push((*f, p));
+        }
+        phase
+            .draw_series(LineSeries::new(seg, color.stroke_width(2)))
+            .map_err(|e| e.to_string())?;
+    }
+    let named: Vec<(usize, &String)> = curves.iter().map(|c| &c.0).enumerate().take(12).collect();
+    draw_legend(&legend, &named, curves.len() - named.len())?;
+    root.present().map_err(|e| e.to_string())
+}

@@ -95,6 +95,12 @@ impl Scenario {
             .or(self.term_selection.as_ref().map(|s| s.accuracy.modes))
     }
 
+    /// A refusal of `[export] damping_ratio` found once the model's mode count is known (a
+    /// list longer than the modes the model has), located where it was written.
+    pub fn refuse_export_damping(&self, reason: impl Into<String>) -> ScenarioError {
+        self.locate_key("export.damping_ratio", reason)
+    }
+
     /// Like [`Scenario::locate`], for one of the keys the run checks after parsing.
     fn locate_key(&self, key: &'static str, reason: impl Into<String>) -> ScenarioError {
         ScenarioError {
@@ -390,6 +396,10 @@ fn sources(cx: &Ctx, raw: &RawScenario) -> Sources {
     if let Some(d) = &raw.deployment {
         let span = context::span_or(&d.get_ref().output_rate, d.span());
         keys.insert("deployment.output_rate", loc(span));
+    }
+    if let Some(e) = &raw.export {
+        let span = context::span_or(&e.get_ref().damping_ratio, e.span());
+        keys.insert("export.damping_ratio", loc(span));
     }
     Sources {
         file: cx.file.to_string(),

@@ -1,0 +1,283 @@
+//! `flexcraft export`: model.json (and the same arrays in model.npz and model.mat), the
+//! frequency response (frequency_response.csv, plots/bode.{png,svg}) and the terminal
+//! summary. Conventions: docs/export.md.
+
+use super::names::csv_bytes;
+use super::{num, OutputDir, OutputError};
+use crate::export::{transfer_unit, ExportModel, PointLocation, Transfer};
+use crate::ritz::ModalAnalysis;
+use crate::structure::{HubMotion, Structure};
+use faer::Mat;
+use serde_json::{json, Value};
+
+const DIRECTIONS: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+const TWO_PI: f64 = 2.0 * std::f64::consts::PI;
+
+/// A matrix as a JSON array of rows.
+fn rows(m: &Mat<f64>) -> Value {
+    Value::Array(
+        (0..m.nrows())
+            .map(|i| Value::Array((0..m.ncols()).map(|j| json!(m[(i, j)])).collect()))
+            .collect(),
+    )
+}
+
+fn rows6(m: &[[f64; 6]; 6]) -> Value {
+    json!(m.iter().map(|r| r.to_vec()).collect::<Vec<_>>())
+}
+
+/// Where a named point sits, for model.json and the 42 node file.
+pub(crate) fn describe_location(st: &Structure, loc: &PointLocation) -> Value {
+    match *loc {
+        PointLocation::Hub { position } => json!({"component": "hub", "position_m": position.0}),
+        PointLocation::Beam { beam, station } => {
+            json!({"component": st.beams()[beam].name(), "station_m": station})
+        }
+        PointLocation::Plate { plate, xi, eta } => {
+            json!({"component": st.plates()[plate].name(), "xi": xi, "eta": eta})
+        }
+        PointLocation::Mass { mass } => json!({"component": st.masses()[mass].name()}),
+    }
+}
+
+/// Names of the rows of the mode shapes at the sites: `hub.ux … hub.rz`, `<point>.ux …`.
+pub(crate) fn site_row_names(ex: &ExportModel) -> Vec<String> {
+    std::iter::once("hub")
+        .chain(ex.points.iter().map(|p| p.name.as_str()))
+        .flat_map(|s| {
+            ["ux", "uy", "uz", "rx", "ry", "rz"]
+                .iter()
+                .map(move |c| format!("{s}.{c}"))
+        })
+        .collect()
+}
+
+/// The frequency response of one transfer at frequencies `f_hz`.
+fn response_of(ex: &ExportModel, t: &Transfer, f_hz: &[f64]) -> Vec<faer::c64> {
+    let (o, i) = (
+        ex.output_index(&t.output).unwrap_or(0),
+        ex.input_index(&t.input).unwrap_or(0),
+    );
+    f_hz.iter().map(|f| ex.transfer(o, i, TWO_PI * f)).collect()
+}
+
+/// model.json: every array of the export with its names and units.
+pub fn export_json(
+    st: &Structure,
+    modes: &ModalAnalysis,
+    ex: &ExportModel,
+    transfers: &[Transfer],
+) -> String {
+    let ss = ex.first_order();
+    let n = ex.mode_count();
+    let estimates: Vec<Option<f64>> = {
+        let mut el = modes.elastic().map(|m| m.frequency_error_estimate);
+        ex.modes
+            .iter()
+            .map(|m| if m.rigid { None } else { el.next().flatten() })
+            .collect()
+    };
+    let mode_list: Vec<Value> = ex
+        .modes
+        .iter()
+        .zip(&estimates)
+        .enumerate()
+        .map(|(j, (m, e))| {
+            json!({
+                "number": j + 1,
+                "rigid": m.rigid,
+                "frequency_hz": m.omega_rad_s / TWO_PI,
+                "omega_rad_s": m.omega_rad_s,
+                "damping_ratio": m.damping_ratio,
+                "frequency_error_estimate": e,
+            })
+        })
+        .collect();
+    let points: Vec<Value> = ex
+        .points
+        .iter()
+        .zip(ex.site_positions.iter().skip(1))
+        .map(|(p, x)| {
+            let mut v = describe_location(st, &p.location);
+            v["name"] = json!(p.name);
+            v["position_m"] = json!(x.0);
+            v
+        })
+        .collect();
+    let v = json!({
+        "units": {
+            "frequency_hz": "Hz", "omega_rad_s": "rad/s",
+            "inputs": "N (f*), N·m (t*)",
+            "outputs": "m (x, y, z, u*), rad (r*), m/s (v*), rad/s (w*)",
+            "rigid_mass": "kg, kg·m (first moments), kg·m² (inertia)",
+            "mode_shapes": "mass-normalised: m/√kg and rad/√kg per unit modal coordinate",
+            "participation": "√kg (x, y, z), √kg·m (rx, ry, rz)",
+            "effective_mass": "kg (x, y, z), kg·m² (rx, ry, rz)",
+        },
+        "conventions": "Structure (hub) frame; the hub's inputs act at and its outputs are read at \
+            the hub's reference point (the frame's origin); modal coordinates eta of \
+            mass-normalised modes, rigid first when the hub is free; second order: \
+            M eta'' + C eta' + K eta = B u, y = F eta + G eta' + D u; first order: \
+            x = [eta; eta'], x' = A x + B u, y = C x + D u. See docs/export.md.",
+        "name": st.name(),
+        "hub_motion": match ex.hub_motion { HubMotion::Free => "free", HubMotion::Fixed => "fixed" },
+        "ritz": super::modes::selection_json(modes),
+        "modes": mode_list,
+        "points": points,
+        "mode_shapes_at_points": {
+            "rows": site_row_names(ex),
+            "values": rows(&ex.site_shapes),
+        },
+        "rigid_body": {
+            "total_mass_kg": ex.total_mass,
+            "center_of_mass_m": ex.center_of_mass.0,
+            "mass_matrix_about_reference_point": rows6(&ex.rigid_mass_reference),
+            "mass_matrix_about_center_of_mass": rows6(&ex.rigid_mass_cm),
+        },
+        "hub_fixed_modes": {
+            "directions": DIRECTIONS,
+            "about": "the hub's centre of mass, structure axes",
+            "frequency_hz": ex.hub_fixed_omega.iter().map(|w| w / TWO_PI).collect::<Vec<_>>(),
+            "participation": rows(&ex.participation),
+            "effective_mass": rows(&ex.effective_mass),
+            "cumulative_effective_mass_fraction": rows(&ex.effective_mass_fraction),
+            "appendage_mass": ex.appendage_mass,
+        },
+        "input_names": ex.input_names,
+        "output_names": ex.output_names,
+        "state_names": ss.state_names,
+        "second_order": {
+            "M": rows(&Mat::<f64>::identity(n, n)),
+            "C": rows(&ex.damping()),
+            "K": rows(&ex.stiffness()),
+            "B": rows(&ex.b),
+            "F": rows(&ex.f),
+            "G": rows(&ex.g),
+            "D": rows(&Mat::<f64>::zeros(ex.output_names.len(), ex.input_names.len())),
+        },
+        "first_order": {
+            "A": rows(&ss.a), "B": rows(&ss.b), "C": rows(&ss.c), "D": rows(&ss.d),
+        },
+        "transfers": transfers.iter().map(|t| json!({
+            "input": t.input, "output": t.output,
+            "unit": transfer_unit(&t.input, &t.output),
+        })).collect::<Vec<_>>(),
+    });
+    serde_json::to_string_pretty(&v).unwrap_or_default()
+}
+
+/// The terminal summary of an export.
+pub fn export_table(st: &Structure, ex: &ExportModel, transfers: &[Transfer]) -> String {
+    let mut o = String::new();
+    let rigid = ex.modes.iter().filter(|m| m.rigid).count();
+    o += &format!(
+        "Linear model of \"{}\" (hub {}): {} modes ({} rigid, {} elastic), {} states, {} inputs, {} outputs. SI units.\n",
+        st.name(),
+        match ex.hub_motion {
+            HubMotion::Free => "free",
+            HubMotion::Fixed => "fixed",
+        },
+        ex.mode_count(),
+        rigid,
+        ex.mode_count() - rigid,
+        2 * ex.mode_count(),
+        ex.input_names.len(),
+        ex.output_names.len()
+    );
+    o += &format!(
+        "Total mass {:.6} kg, centre of mass ({:.4}, {:.4}, {:.4}) m.\n\n",
+        ex.total_mass, ex.center_of_mass.0[0], ex.center_of_mass.0[1], ex.center_of_mass.0[2]
+    );
+    o += "  mode   frequency [Hz]   damping ratio\n";
+    for (j, m) in ex.modes.iter().enumerate() {
+        if m.rigid {
+            o += &format!("  {:>4}   {:>14}   rigid\n", j + 1, "0");
+        } else {
+            o += &format!(
+                "  {:>4}   {:>14.6}   {:.4}\n",
+                j + 1,
+                m.omega_rad_s / TWO_PI,
+                m.damping_ratio
+            );
+        }
+    }
+    if let Some(last) = ex.effective_mass_fraction.ncols().checked_sub(1) {
+        o += "\nHub-fixed modes' cumulative effective mass (fraction of the appendages' rigid mass):\n ";
+        for (d, name) in DIRECTIONS.iter().enumerate() {
+            o += &format!(" {name} {:.4}", ex.effective_mass_fraction[(d, last)]);
+        }
+        o += "\n";
+    }
+    o += "\nTransfer functions: ";
+    o += &transfers
+        .iter()
+        .map(|t| format!("{} → {}", t.input, t.output))
+        .collect::<Vec<_>>()
+        .join(", ");
+    o += "\n";
+    o
+}
+
+/// frequency_response.csv: per transfer, the real and imaginary parts, magnitude and phase.
+fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io::Result<Vec<u8>> {
+    let h: Vec<Vec<faer::c64>> = transfers.iter().map(|t| response_of(ex, t, f)).collect();
+    csv_bytes(|w| {
+        let mut header = vec!["frequency [Hz]".to_string(), "omega [rad/s]".to_string()];
+        for t in transfers {
+            let unit = transfer_unit(&t.input, &t.output);
+            let tag = format!("{}->{}", t.input, t.output);
+            header.push(format!("{tag} re [{unit}]"));
+            header.push(format!("{tag} im [{unit}]"));
+            header.push(format!("{tag} magnitude [{unit}]"));
+            header.push(format!("{tag} phase [deg]"));
+        }
+        w.write_record(&header)?;
+        for (k, fk) in f.iter().enumerate() {
+            w.write_field(num(*fk))?;
+            w.write_field(num(TWO_PI * fk))?;
+            for ht in &h {
+                let z = ht[k];
+                w.write_field(num(z.re))?;
+                w.write_field(num(z.im))?;
+                w.write_field(num(z.norm()))?;
+                w.write_field(num(z.arg().to_degrees()))?;
+            }
+            w.write_record(None::<&[u8]>)?;
+        }
+        Ok(())
+    })
+}
+
+/// Writes model.json, frequency_response.csv and plots/bode.{png,svg}.
+pub fn write_export(
+    dir: &mut OutputDir,
+    st: &Structure,
+    modes: &ModalAnalysis,
+    ex: &ExportModel,
+    transfers: &[Transfer],
+    range_hz: Option<(f64, f64)>,
+    points: usize,
+) -> Result<(), OutputError> {
+    dir.write("model.json", export_json(st, modes, ex, transfers) + "\n")?;
+    let f = ex.frequency_grid(range_hz, points);
+    dir.write("frequency_response.csv", frequency_csv(ex, transfers, &f)?)?;
+    if !transfers.is_empty() {
+        let curves: Vec<(String, Vec<(f64, faer::c64)>)> = transfers
+            .iter()
+            .map(|t| {
+                let h = response_of(ex, t, &f);
+                (
+                    format!("{} → {}", t.input, t.output),
+                    f.iter().copied().zip(h).collect(),
+                )
+            })
+            .collect();
+        super::plot::bode_chart(
+            dir,
+            "bode",
+            &format!("Frequency response of {}", st.name()),
+            &curves,
+        )?;
+    }
+    Ok(())
+}
