@@ -373,3 +373,134 @@ terms = { bending = 16, torsion = 4, axial = 4 }
         }
     }
 }
+
+/// Every bad `[export]` value is refused through the binary with its file:line, key and
+/// reason, exit status 2, and nothing written.
+#[test]
+fn export_keys_are_refused_with_location() {
+    use super::hardening_input::{assert_refused, run};
+    let dir = super::common::scratch("export_keys");
+    let base = include_str!("../../examples/export.toml");
+    for (from, to, key, reason) in [
+        (
+            "component = \"mast\"",
+            "component = \"mats\"",
+            "export.points[1].component",
+            "no component is named \"mats\"",
+        ),
+        (
+            "station = 13.0\n\n[[export.points]]\nname = \"wing_tip\"",
+            "station = 13.5\n\n[[export.points]]\nname = \"wing_tip\"",
+            "export.points[1].station",
+            "0 to 13 m",
+        ),
+        (
+            "xi = 1.0",
+            "xi = 1.2",
+            "export.points[2].xi",
+            "must lie in [0, 1]",
+        ),
+        (
+            "name = \"mast_tip\"",
+            "name = \"star_tracker\"",
+            "export.points[1].name",
+            "already defined",
+        ),
+        (
+            "name = \"mast_tip\"",
+            "name = \"hub\"",
+            "export.points[1].name",
+            "reserved",
+        ),
+        (
+            "name = \"mast_tip\"",
+            "name = \"mast tip\"",
+            "export.points[1].name",
+            "not a point name",
+        ),
+        (
+            "output = \"hub.rz\"",
+            "output = \"hub.rq\"",
+            "export.transfer[0].output",
+            "no output is named \"hub.rq\"",
+        ),
+        (
+            "input = \"hub.tx\"\noutput = \"wing_tip.uz\"",
+            "input = \"wing.tx\"\noutput = \"wing_tip.uz\"",
+            "export.transfer[2].input",
+            "no input is named \"wing.tx\"",
+        ),
+        (
+            "damping_ratio = 0.005",
+            "damping_ratio = 1.0",
+            "export.damping_ratio",
+            "[0, 1)",
+        ),
+        (
+            "damping_ratio = 0.005",
+            "damping_ratio = [0.01, 0.02]",
+            "export.damping_ratio",
+            "lists 2 values but export.modes = 12",
+        ),
+        (
+            "damping_ratio = 0.005",
+            "damping_ratio = [0.01, -0.02]",
+            "export.damping_ratio",
+            "[0, 1)",
+        ),
+        ("modes = 12", "modes = 0", "export.modes", "from 1 to"),
+        (
+            "position = [0.5, 0.0, 0.8]",
+            "position = [0.5, 0.0, 0.8]\nstation = 1.0",
+            "export.points[0].station",
+            "does not take this key",
+        ),
+    ] {
+        let src = base.replacen(from, to, 1);
+        assert!(src != base, "{to}");
+        let out = run(&dir, "export", &src, &[]);
+        // The refused value's line: where `to` went in, at its line naming the key.
+        let field = key.rsplit('.').next().unwrap();
+        let within = to
+            .lines()
+            .position(|l| l.trim_start().starts_with(field))
+            .unwrap_or(0);
+        let line = base[..base.find(from).unwrap()].matches('\n').count() + 1 + within;
+        assert_refused(&dir, &out, line, key, reason);
+    }
+    // A damping list longer than the modes the model has: found after the solve, located.
+    let src = base
+        .replacen("modes = 12\n", "", 1)
+        .replacen("tolerance = 1e-5\n", "tolerance = 1e-5\nmodes = 3\n", 1)
+        .replacen(
+            "damping_ratio = 0.005",
+            "damping_ratio = [0.01, 0.02, 0.03, 0.04]",
+            1,
+        );
+    let out = run(&dir, "export", &src, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    // The list sets the kept modes (4) and the automatic terms aim at them: accepted.
+    assert_eq!(out.status.code(), Some(0), "{err}");
+}
+
+/// The same input gives byte-identical files.
+#[test]
+fn export_is_byte_identical_between_runs() {
+    use super::common::{assert_same_tree, bin, example, scratch};
+    let dir = scratch("export_twice");
+    for k in ["a", "b"] {
+        let out = bin()
+            .arg("export")
+            .arg(example("export.toml"))
+            .arg("--out")
+            .arg(dir.join(k))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert!(assert_same_tree(&dir.join("a"), &dir.join("b")) >= 4);
+}

@@ -14,7 +14,7 @@ const SEED: &str = include_str!("../../examples/seed.toml");
 const FREE_HUB: &str = include_str!("../../examples/free_hub.toml");
 
 /// Writes `src` as `dir/scenario.toml` and runs `flexcraft SUB it --out dir/out ARGS`.
-fn run(dir: &Path, sub: &str, src: impl AsRef<[u8]>, args: &[&str]) -> Output {
+pub fn run(dir: &Path, sub: &str, src: impl AsRef<[u8]>, args: &[&str]) -> Output {
     let f = dir.join("scenario.toml");
     std::fs::write(&f, src).unwrap();
     bin()
@@ -28,7 +28,7 @@ fn run(dir: &Path, sub: &str, src: impl AsRef<[u8]>, args: &[&str]) -> Output {
 }
 
 /// Exit 2, one line `file:LINE:col: KEY…: …REASON…`, and nothing but the scenario in `dir`.
-fn assert_refused(dir: &Path, out: &Output, line: usize, key: &str, reason: &str) {
+pub fn assert_refused(dir: &Path, out: &Output, line: usize, key: &str, reason: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     let loc = format!("scenario.toml:{line}:");
@@ -43,7 +43,7 @@ fn assert_refused(dir: &Path, out: &Output, line: usize, key: &str, reason: &str
 }
 
 /// The 1-based line of the first occurrence of `needle` in `src`.
-fn line_of(src: &str, needle: &str) -> usize {
+pub fn line_of(src: &str, needle: &str) -> usize {
     let at = src
         .find(needle)
         .unwrap_or_else(|| panic!("{needle} not in source"));
