@@ -1,6 +1,7 @@
 //! Outputs: the terminal table, JSON, CSV files and plots. Everything is deterministic (no
 //! time stamps; shortest round-trip float formatting) and written through [`OutputDir`].
 
+mod arrays;
 mod atomic;
 mod deploy;
 pub(crate) mod figures;
@@ -14,6 +15,7 @@ mod simulate;
 mod tests;
 pub(crate) mod view3d;
 
+pub use arrays::{mat_bytes, npz_bytes, ArrayFileError, ArrayValue, NameProblem};
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, write_deploy};
 pub use modes::{modes_json, modes_table, write_modes};
