@@ -23,10 +23,13 @@
 //! - [`ArrayValue::Real`] takes its data in row-major (C) order, as NumPy does; the MAT writer
 //!   transposes to MATLAB's column-major order. A 1-d array of n values is an n×1 column in
 //!   MATLAB (a per-mode vector reads as a column, as `eig` returns them) and a 0-d array 1×1.
-//! - Text is stored exactly (Unicode): NumPy `<U` (UTF-32), MATLAB char data as UTF-16
-//!   (`miUTF16`), whose code units are MATLAB's characters. Octave reads the ASCII part of
-//!   UTF-16 char data and replaces other characters by `?` with a warning (Octave's
-//!   `ls-mat5.cc`); the names flexcraft writes are ASCII.
+//! - Text: NumPy `<U` (UTF-32) holds it exactly. MATLAB char data are written as UTF-16
+//!   (`miUTF16`), whose code units are MATLAB's characters, with one exception: a character
+//!   beyond the Basic Multilingual Plane (an emoji, a mathematical italic letter) becomes
+//!   U+FFFD, because SciPy decodes char data to code points and then needs exactly as many as
+//!   the dimensions count UTF-16 units (a surrogate pair makes `loadmat` fail). Octave reads
+//!   the ASCII part of UTF-16 char data and replaces other characters by `?` with a warning
+//!   (Octave's `ls-mat5.cc`); the names flexcraft writes are ASCII.
 //! - Names follow MATLAB's rules for variable names in both files (so that one list of names
 //!   serves both): a letter, then letters, digits and `_`, at most 63 characters, not a MATLAB
 //!   keyword.
@@ -444,7 +447,11 @@ fn matrix_element(name: &str, value: &ArrayValue) -> Result<Vec<u8>, (u64, usize
             dims
         }
         ArrayValue::Text(s) => {
-            let units: Vec<u16> = s.encode_utf16().collect();
+            // One UTF-16 unit per character: beyond the BMP, U+FFFD (see the module docs).
+            let units: Vec<u16> = s
+                .chars()
+                .map(|c| u16::try_from(u32::from(c)).unwrap_or(0xFFFD))
+                .collect();
             let dims = vec![1, units.len()];
             push_matrix_head(&mut body, MX_CHAR_CLASS, &dims, name)?;
             let bytes: Vec<u8> = units.iter().flat_map(|u| u.to_le_bytes()).collect();
@@ -890,7 +897,7 @@ mod tests {
             )
         );
         let char_row = |s: &str| MatVar::Char {
-            dims: vec![1, s.encode_utf16().count() as i32],
+            dims: vec![1, s.chars().count() as i32],
             text: s.into(),
         };
         assert_eq!(
@@ -961,12 +968,12 @@ mod tests {
         let (text, vars) = mat_read(&bytes);
         assert_eq!(text.len(), 116);
         assert!(text.starts_with("MATLAB 5.0 MAT-file, ??xxx"));
-        // 𝜔 is a surrogate pair: two MATLAB characters.
+        // 𝜔 (beyond the BMP) would be a surrogate pair, which SciPy cannot read: U+FFFD.
         assert_eq!(
             vars[0].1,
             MatVar::Char {
-                dims: vec![1, 5],
-                text: "θ° 𝜔".into()
+                dims: vec![1, 4],
+                text: "θ° \u{FFFD}".into()
             }
         );
     }
