@@ -1,6 +1,7 @@
 //! Outputs: the terminal table, JSON, CSV files and plots. Everything is deterministic (no
 //! time stamps; shortest round-trip float formatting) and written through [`OutputDir`].
 
+mod arrays;
 mod atomic;
 mod deploy;
 mod export;
@@ -15,6 +16,7 @@ mod simulate;
 mod tests;
 pub(crate) mod view3d;
 
+pub use arrays::{mat_bytes, npz_bytes, ArrayFileError, ArrayValue, NameProblem};
 pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, write_deploy};
 pub use export::{export_json, export_table, write_export};
