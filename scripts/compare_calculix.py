@@ -8,52 +8,62 @@ Run from anywhere (needs cargo, and `ccx` on PATH: Debian's `apt-get install cal
     python3 scripts/compare_calculix.py --keep DIR # keep the decks and outputs in DIR
 
 Python 3.11 standard library only. Everything is measured in one run on one machine, so the
-time ratios hold on another machine; the absolute times do not.
+time ratios hold on another machine; the absolute times do not (nor on a loaded machine).
 
 What is compared: the first 10 elastic frequencies of the free spacecraft of
 examples/composite.toml (the six rigid-body modes come first in both tools and are skipped).
-Both tools run as whole processes (start, read, assemble, solve, print), best of 3, with
-their default threading (flexcraft: faer's thread pool; ccx: OMP_NUM_THREADS = the number of
-cores, so SPOOLES may use them).
+Both tools run as whole processes (start, read, assemble, solve, print), best of 3, on one
+thread: flexcraft is sequential (faer without its "rayon" feature), and ccx gets
+OMP_NUM_THREADS=1 (its default; with 2 threads on a busy 2-core machine it spun 20× slower).
 
 flexcraft: `flexcraft modes --json` on copies of the example with `[ritz] tolerance` 1e-2 …
 1e-6 (automatic terms) and with explicit `terms` sequences (no `[ritz]` table).
 
-CalculiX: one deck per mesh, *FREQUENCY for 20 modes (6 rigid + 14 elastic), eigenvalues
-read from the .dat file. The model, and where it differs from flexcraft's continuum:
+CalculiX: one deck per mesh, *FREQUENCY for 20 modes above 0.2 Hz printed (the 6 rigid ones,
+at ~0, drop out; 14 elastic remain), eigenvalues read from the .dat file. The model, and where
+it differs from flexcraft's continuum:
 
 * Mast: B32R elements (three-node, reduced integration) with *BEAM SECTION, SECTION=PIPE,
   outer radius 0.15 m, wall 5 mm. CalculiX 2.20 accepts SECTION=PIPE only on B32R ("*BEAM
   SECTION of type PIPE can only be used for B32R elements"), so B32R stands in for the B32 the
   issue names; CalculiX expands either into C3D20R bricks. The expanded tube is a 3-D solid:
   it has transverse shear flexibility and rotary inertia, which flexcraft's Euler–Bernoulli
-  beam has not (docs/theory.md §1.1), so its mast-bending frequencies converge to slightly
-  lower values.
+  beam has not (docs/theory.md §1.1); on the mast alone (free–free) that lowers the first
+  bending frequency by 0.27 %.
 * Wing: S8R shells (eight-node, reduced integration) in the plane z = 13 m, length along +x
   from the mast tip, the root edge (x = 0, width 3.75 m) centred on the mast axis, as
   docs/scenario.md places it. flexcraft's plate is a Kirchhoff plate given by D and ρh only,
-  rigid in its own plane. The shell gets a thickness h = 5 mm and the E and ρ that give the
-  same D = E h³/12(1 − ν²) = 6.2e5 N·m and ρh = 8 kg/m² (E = 5.42e13 Pa, ρ = 1600 kg/m³,
-  ν = 0.3): a thin shell has little transverse shear (Mindlin) flexibility and a large
-  membrane stiffness E h = 2.7e11 N/m, so its first in-plane mode is near 500 Hz, far above
-  the 16 Hz of the 10th elastic mode.
-* Tie: the root edge's nodes form a *RIGID BODY whose reference node is the mast's tip node
-  (flexcraft: "clamped along the root edge to a rigid massless yoke at the attachment").
-* Hub: CalculiX 2.20 has no *ROTARY INERTIA (it came later), so the hub's 800 kg and its
-  inertia [600, 600, 400] kg·m² about its centre of mass (0, 0, −1) are six *MASS points
-  one metre from that centre along ±x (100 kg each), ±y (100 kg each) and ±z (200 kg each),
-  which gives exactly that mass, centre and inertia tensor, made one *RIGID BODY with the
-  mast's root node as reference node. It is the same rigid body, with the same mass matrix.
+  rigid in its own plane. The shell gets a thickness h = 20 mm and the E and ρ that give the
+  same D = E h³/12(1 − ν²) = 6.2e5 N·m and ρh = 8 kg/m² (E = 8.46e11 Pa, ρ = 400 kg/m³,
+  ν = 0.3): its span/thickness ratio 190 keeps its transverse shear (Mindlin) small, and its
+  membrane stiffness E h = 1.7e10 N/m puts its first in-plane mode near 120 Hz, far above the
+  16 Hz of the 10th elastic mode. Thinner shells (h = 5 mm, E = 5.4e13 Pa) made CalculiX's
+  expanded shells erratic: the clamped wing's fundamental jumped by 4 % between meshes.
+* Tie: CalculiX 2.20's *RIGID BODY carries only the translation of a beam node (tried: a
+  cantilever clamped through a rigid body on its root node swings like a pin), so the rigid
+  connections are stiff massless beams instead, whose shared nodes CalculiX turns into rigid
+  "knots": the yoke is a B32R beam along the wing's root edge through its nodes, whose
+  middle node is the mast's tip node (flexcraft: "clamped along the root edge to a rigid
+  massless yoke at the attachment"). Their E is 1e4 times the mast's, a solid circle of
+  radius 0.1 m, density 1e-3 kg/m³: 10 times stiffer changes no frequency by more than 1e-5,
+  100 times stiffer makes the solution noisy (conditioning).
+* Hub: CalculiX 2.20 has no *ROTARY INERTIA (added in a later version), so the hub's 800 kg
+  and inertia [600, 600, 400] kg·m² about its centre of mass (0, 0, −1) are seven *MASS
+  points: 64 kg at ±1.25 m along x and along y, 128 kg at ±1.25 m along z, 288 kg at the
+  centre, which is exactly that mass, centre and inertia tensor; a spider of the same stiff
+  beams joins them to the mast's root node. It is the same rigid body with the same mass.
 
 Error: each run's largest relative error over the first 10 elastic frequencies,
 max_k |f_k − f_k,ref| / f_k,ref, against each tool's own converged limit:
-  flexcraft: its finest run (automatic terms at 1e-7, whose estimated error is printed);
+  flexcraft: the reference of tests/suite/term_selection.rs, mast terms 36/20/20, wing width
+            28, wing length 48, 64 and 80 extrapolated (rate fitted per mode);
   CalculiX: a Richardson extrapolation, per mode, of its three finest meshes (each halves
             the element size), with the rate fitted per mode and bounded to [1, 4].
-So each column says how far a run is from what its own model converges to. The table also
-gives the CalculiX limits' difference from flexcraft's reference per mode: what the
-different physics (shear and rotary inertia of the 3-D tube, the shell's transverse shear
-and membrane flexibility) amounts to.
+So each error column says how far a run is from what its own model converges to; the last
+column gives every run's error against flexcraft's reference, and the table above it the
+CalculiX limits' difference from that reference per mode: what the different physics (shear
+and rotary inertia of the 3-D tube, the shell's transverse shear and membrane flexibility)
+amounts to.
 """
 
 import argparse
@@ -86,7 +96,7 @@ REF_WIDTH = 28
 
 # Shell stand-in for the sandwich wing (see the docstring): thickness, and E, ρ from D and ρh.
 SHELL_H_M = 0.02
-# The hub as six point masses one metre from its centre of mass (see the docstring).
+# The hub as point masses this far from its centre of mass along ±x, ±y, ±z (see the docstring).
 HUB_ARM_M = 1.25
 # The stiff massless beams of the yoke and the hub's spider (see the docstring).
 STIFF_E = 7e14  # 1e4 × the mast's E: 10× more changes no frequency by 1e-5; 100× more is noisy
