@@ -1,8 +1,10 @@
 #!/bin/sh
-# Loads the .npz and .mat files of output::arrays in NumPy and SciPy (their reference readers):
-# makes a Python virtual environment under target/ with numpy and scipy (once; later runs reuse
-# it), then runs the ignored test suite::array_files::array_files_load_in_numpy_and_scipy with
-# FLEXCRAFT_PYTHON set to its interpreter. Fails if Python, the install or any check fails.
+# Loads the .npz and .mat files of output::arrays, and those `flexcraft export` writes, in NumPy
+# and SciPy (their reference readers): makes a Python virtual environment under target/ with
+# numpy and scipy (once; later runs reuse it), then runs the ignored tests
+# suite::array_files::array_files_load_in_numpy_and_scipy and
+# suite::export::export_files_load_in_numpy_and_scipy with FLEXCRAFT_PYTHON set to its
+# interpreter. Fails if Python, the install or any check fails.
 set -eu
 cd "$(dirname "$0")/.."
 venv=target/array-check-venv
@@ -13,4 +15,5 @@ if ! "$venv/bin/python" -c "import numpy, scipy" 2>/dev/null; then
 fi
 "$venv/bin/python" -c "import numpy, scipy; print('numpy', numpy.__version__, 'scipy', scipy.__version__)"
 FLEXCRAFT_PYTHON="$PWD/$venv/bin/python" cargo test --release --test lib -- \
-    --ignored --exact suite::array_files::array_files_load_in_numpy_and_scipy --nocapture
+    --ignored --exact suite::array_files::array_files_load_in_numpy_and_scipy \
+    suite::export::export_files_load_in_numpy_and_scipy --nocapture

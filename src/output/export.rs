@@ -3,7 +3,7 @@
 //! summary. Conventions: docs/export.md.
 
 use super::names::csv_bytes;
-use super::{num, OutputDir, OutputError};
+use super::{num, ArrayValue, OutputDir, OutputError};
 use crate::export::{transfer_unit, ExportModel, PointLocation, Transfer};
 use crate::ritz::ModalAnalysis;
 use crate::structure::{HubMotion, Structure};
@@ -218,6 +218,142 @@ pub fn export_table(st: &Structure, ex: &ExportModel, transfers: &[Transfer]) ->
     o
 }
 
+fn matrix(m: &Mat<f64>) -> ArrayValue {
+    ArrayValue::matrix(
+        m.nrows(),
+        m.ncols(),
+        (0..m.nrows())
+            .flat_map(|i| (0..m.ncols()).map(move |j| m[(i, j)]))
+            .collect(),
+    )
+}
+
+fn matrix6(m: &[[f64; 6]; 6]) -> ArrayValue {
+    ArrayValue::matrix(6, 6, m.iter().flatten().copied().collect())
+}
+
+/// The arrays of model.npz and model.mat (names valid in both; docs/export.md lists them).
+pub fn export_arrays(
+    st: &Structure,
+    modes: &ModalAnalysis,
+    ex: &ExportModel,
+) -> Vec<(&'static str, ArrayValue)> {
+    let ss = ex.first_order();
+    let n = ex.mode_count();
+    let mut el = modes.elastic().map(|m| m.frequency_error_estimate);
+    let estimates: Vec<f64> = ex
+        .modes
+        .iter()
+        .map(|m| {
+            if m.rigid {
+                f64::NAN
+            } else {
+                el.next().flatten().unwrap_or(f64::NAN)
+            }
+        })
+        .collect();
+    let strings = |v: &[String]| ArrayValue::Strings(v.to_vec());
+    let sites: Vec<String> = std::iter::once("hub".to_string())
+        .chain(ex.points.iter().map(|p| p.name.clone()))
+        .collect();
+    vec![
+        ("name", ArrayValue::Text(st.name().to_string())),
+        (
+            "hub_motion",
+            ArrayValue::Text(
+                match ex.hub_motion {
+                    HubMotion::Free => "free",
+                    HubMotion::Fixed => "fixed",
+                }
+                .into(),
+            ),
+        ),
+        ("units", ArrayValue::Text(UNITS.to_string())),
+        (
+            "frequency_hz",
+            ArrayValue::vector(ex.modes.iter().map(|m| m.omega_rad_s / TWO_PI).collect()),
+        ),
+        (
+            "omega_rad_s",
+            ArrayValue::vector(ex.modes.iter().map(|m| m.omega_rad_s).collect()),
+        ),
+        (
+            "damping_ratio",
+            ArrayValue::vector(ex.modes.iter().map(|m| m.damping_ratio).collect()),
+        ),
+        (
+            "rigid",
+            ArrayValue::vector(
+                ex.modes
+                    .iter()
+                    .map(|m| f64::from(u8::from(m.rigid)))
+                    .collect(),
+            ),
+        ),
+        ("frequency_error_estimate", ArrayValue::vector(estimates)),
+        ("site_names", strings(&sites)),
+        (
+            "site_positions",
+            ArrayValue::matrix(
+                sites.len(),
+                3,
+                ex.site_positions.iter().flat_map(|p| p.0).collect(),
+            ),
+        ),
+        ("mode_shape_rows", strings(&site_row_names(ex))),
+        ("mode_shapes_at_points", matrix(&ex.site_shapes)),
+        ("total_mass", ArrayValue::scalar(ex.total_mass)),
+        (
+            "center_of_mass",
+            ArrayValue::vector(ex.center_of_mass.0.to_vec()),
+        ),
+        ("rigid_mass_reference", matrix6(&ex.rigid_mass_reference)),
+        ("rigid_mass_cm", matrix6(&ex.rigid_mass_cm)),
+        (
+            "directions",
+            ArrayValue::Strings(DIRECTIONS.iter().map(|d| d.to_string()).collect()),
+        ),
+        (
+            "hub_fixed_frequency_hz",
+            ArrayValue::vector(ex.hub_fixed_omega.iter().map(|w| w / TWO_PI).collect()),
+        ),
+        ("participation", matrix(&ex.participation)),
+        ("effective_mass", matrix(&ex.effective_mass)),
+        (
+            "effective_mass_fraction",
+            matrix(&ex.effective_mass_fraction),
+        ),
+        (
+            "appendage_mass",
+            ArrayValue::vector(ex.appendage_mass.to_vec()),
+        ),
+        ("mechss_M", matrix(&Mat::<f64>::identity(n, n))),
+        ("mechss_C", matrix(&ex.damping())),
+        ("mechss_K", matrix(&ex.stiffness())),
+        ("mechss_B", matrix(&ex.b)),
+        ("mechss_F", matrix(&ex.f)),
+        ("mechss_G", matrix(&ex.g)),
+        (
+            "mechss_D",
+            matrix(&Mat::<f64>::zeros(
+                ex.output_names.len(),
+                ex.input_names.len(),
+            )),
+        ),
+        ("A", matrix(&ss.a)),
+        ("B", matrix(&ss.b)),
+        ("C", matrix(&ss.c)),
+        ("D", matrix(&ss.d)),
+        ("state_names", strings(&ss.state_names)),
+        ("input_names", strings(&ex.input_names)),
+        ("output_names", strings(&ex.output_names)),
+    ]
+}
+
+/// Units and conventions, one line (the array files' `units` text).
+const UNITS: &str = "SI: Hz, rad/s, kg, m, rad, N, N m; mode shapes mass-normalised (m/sqrt(kg), \
+rad/sqrt(kg)); structure (hub) frame, hub inputs/outputs at its reference point; docs/export.md";
+
 /// frequency_response.csv: per transfer, the real and imaginary parts, magnitude and phase.
 fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io::Result<Vec<u8>> {
     let h: Vec<Vec<faer::c64>> = transfers.iter().map(|t| response_of(ex, t, f)).collect();
@@ -259,6 +395,13 @@ pub fn write_export(
     points: usize,
 ) -> Result<(), OutputError> {
     dir.write("model.json", export_json(st, modes, ex, transfers) + "\n")?;
+    let arrays = export_arrays(st, modes, ex);
+    let bad = |e: super::ArrayFileError| OutputError::Io(std::io::Error::other(e.to_string()));
+    dir.write("model.npz", super::npz_bytes(&arrays).map_err(bad)?)?;
+    dir.write(
+        "model.mat",
+        super::mat_bytes(&arrays, "flexcraft export, SI units").map_err(bad)?,
+    )?;
     let f = ex.frequency_grid(range_hz, points);
     dir.write("frequency_response.csv", frequency_csv(ex, transfers, &f)?)?;
     if !transfers.is_empty() {

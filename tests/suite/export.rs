@@ -504,3 +504,45 @@ fn export_is_byte_identical_between_runs() {
     }
     assert!(assert_same_tree(&dir.join("a"), &dir.join("b")) >= 4);
 }
+
+/// The exported files read by the programs they are for: `scripts/check_export_files.py`
+/// loads model.npz with NumPy and model.mat with SciPy, compares them with model.json, checks
+/// A's poles, and evaluates C (iωI − A)⁻¹ B + D by a dense complex solve against
+/// frequency_response.csv (a second formulation of the modal sum). Ignored by default (it
+/// needs Python with numpy and scipy): `scripts/check_array_files.sh` runs it.
+#[test]
+#[ignore = "needs Python with numpy and scipy: scripts/check_array_files.sh"]
+fn export_files_load_in_numpy_and_scipy() {
+    use super::common::{bin, example, scratch};
+    let Some(python) = std::env::var_os("FLEXCRAFT_PYTHON") else {
+        println!("FLEXCRAFT_PYTHON not set: skipped (run scripts/check_array_files.sh)");
+        return;
+    };
+    let dir = scratch("export-python");
+    let out = bin()
+        .arg("export")
+        .arg(example("export.toml"))
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let script =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_export_files.py");
+    let out = std::process::Command::new(&python)
+        .arg(&script)
+        .arg(dir.join("out"))
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run FLEXCRAFT_PYTHON={python:?}: {e}"));
+    print!("{}", String::from_utf8_lossy(&out.stdout));
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
