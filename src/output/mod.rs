@@ -3,6 +3,7 @@
 
 mod atomic;
 mod deploy;
+pub mod flex42;
 pub(crate) mod figures;
 mod modes;
 mod names;
