@@ -405,7 +405,9 @@ pub enum Flex42Error {
         length: usize,
     },
     /// A data line without a trailing comment: 42 would swallow the next line as its comment.
-    #[error("line {line}: data without a trailing comment (42 would read the next line as the comment)")]
+    #[error(
+        "line {line}: data without a trailing comment (42 would read the next line as the comment)"
+    )]
     MissingComment {
         /// 1-based line of the data.
         line: usize,
@@ -446,7 +448,9 @@ impl FlexBody {
     /// Does not check the mass normalisation (see [`flex_file`]).
     pub fn validate(&self) -> Result<(), Flex42Error> {
         let name_ok = !self.name.is_empty()
-            && flex_file_name(&self.name).len().max(nodes_file_name(&self.name).len())
+            && flex_file_name(&self.name)
+                .len()
+                .max(nodes_file_name(&self.name).len())
                 <= MAX_FILE_NAME
             && !self
                 .name
@@ -731,7 +735,11 @@ fn push_diagonal(out: &mut String, header: &str, diagonal: &[f64]) {
         .enumerate()
         .filter(|&(_, v)| v != 0.0)
         .collect();
-    push_data(out, &nonzero.len().to_string(), "Number of non-zero elements");
+    push_data(
+        out,
+        &nonzero.len().to_string(),
+        "Number of non-zero elements",
+    );
     for (i, v) in nonzero {
         push_data(out, &format!("{i} {i} {}", num(v)), "[Row] [Col] Value");
     }
@@ -921,7 +929,13 @@ impl<'a> Scanner<'a> {
 
     /// A snippet of what is at the cursor, for error messages.
     fn found(&self) -> String {
-        self.rest().lines().next().unwrap_or("").chars().take(40).collect()
+        self.rest()
+            .lines()
+            .next()
+            .unwrap_or("")
+            .chars()
+            .take(40)
+            .collect()
     }
 
     fn parse_error(&self, expected: &'static str) -> Flex42Error {
@@ -933,7 +947,7 @@ impl<'a> Scanner<'a> {
     }
 
     /// `%[^\n]` into an 80-byte buffer: one or more bytes up to the line break.
-    fn to_line_end(&mut self, expected: &'static str) -> Result<&'a str, Flex42Error> {
+    fn read_line_rest(&mut self, expected: &'static str) -> Result<&'a str, Flex42Error> {
         let rest = self.rest();
         let len = rest.find('\n').unwrap_or(rest.len());
         let s = rest[..len].trim_end_matches('\r');
@@ -952,7 +966,7 @@ impl<'a> Scanner<'a> {
 
     /// `fscanf("%[^\n] %[\n]")`: a whole comment line, then white space.
     fn comment_line(&mut self, expected: &'static str) -> Result<&'a str, Flex42Error> {
-        let s = self.to_line_end(expected)?;
+        let s = self.read_line_rest(expected)?;
         self.skip_ws();
         Ok(s)
     }
@@ -963,7 +977,7 @@ impl<'a> Scanner<'a> {
         if self.line() != line {
             return Err(Flex42Error::MissingComment { line });
         }
-        self.to_line_end("a trailing comment")?;
+        self.read_line_rest("a trailing comment")?;
         self.skip_ws();
         Ok(())
     }
@@ -1465,15 +1479,16 @@ mod tests {
             simpson(n, |x| MU * beam(x)) + over_box(tip)
         };
         let pf = (0..nf)
-            .map(|p| std::array::from_fn(|a| both(&|x| modes[p].psi(x)[a], &|rho| tip_u(p, rho)[a])))
+            .map(|p| {
+                std::array::from_fn(|a| both(&|x| modes[p].psi(x)[a], &|rho| tip_u(p, rho)[a]))
+            })
             .collect();
         let hf = (0..nf)
             .map(|p| {
                 std::array::from_fn(|a| {
-                    both(
-                        &|x| cross(beam_r(x), modes[p].psi(x))[a],
-                        &|rho| cross(tip_r(rho), tip_u(p, rho))[a],
-                    )
+                    both(&|x| cross(beam_r(x), modes[p].psi(x))[a], &|rho| {
+                        cross(tip_r(rho), tip_u(p, rho))[a]
+                    })
                 })
             })
             .collect();
@@ -1481,10 +1496,9 @@ mod tests {
             .map(|p| {
                 std::array::from_fn(|i| {
                     std::array::from_fn(|j| {
-                        both(
-                            &|x| modes[p].psi(x)[i] * beam_r(x)[j],
-                            &|rho| tip_u(p, rho)[i] * tip_r(rho)[j],
-                        )
+                        both(&|x| modes[p].psi(x)[i] * beam_r(x)[j], &|rho| {
+                            tip_u(p, rho)[i] * tip_r(rho)[j]
+                        })
                     })
                 })
             })
@@ -1492,10 +1506,9 @@ mod tests {
         let n_pq = |p: usize, q: usize| -> Mat3 {
             std::array::from_fn(|i| {
                 std::array::from_fn(|j| {
-                    both(
-                        &|x| modes[p].psi(x)[i] * modes[q].psi(x)[j],
-                        &|rho| tip_u(p, rho)[i] * tip_u(q, rho)[j],
-                    )
+                    both(&|x| modes[p].psi(x)[i] * modes[q].psi(x)[j], &|rho| {
+                        tip_u(p, rho)[i] * tip_u(q, rho)[j]
+                    })
                 })
             })
         };
@@ -1590,8 +1603,14 @@ mod tests {
             } else {
                 (got.pf[p][2], -got.hf[p][1])
             };
-            assert!((pf - shear).abs() < 1e-10 * shear.abs(), "mode {p}: {pf} vs {shear}");
-            assert!((h - moment).abs() < 1e-10 * moment.abs(), "mode {p}: {h} vs {moment}");
+            assert!(
+                (pf - shear).abs() < 1e-10 * shear.abs(),
+                "mode {p}: {pf} vs {shear}"
+            );
+            assert!(
+                (h - moment).abs() < 1e-10 * moment.abs(),
+                "mode {p}: {h} vs {moment}"
+            );
         }
     }
 
@@ -1669,7 +1688,10 @@ mod tests {
         let text = flex_file(&b).unwrap();
         let parsed = read_flex_file(&text).unwrap();
         let integrals = modal_integrals(&b).unwrap();
-        assert_eq!(parsed.description, "flexcraft boom                       ! Description");
+        assert_eq!(
+            parsed.description,
+            "flexcraft boom                       ! Description"
+        );
         let initial: Vec<(f64, f64)> = b
             .modes
             .iter()
@@ -1689,7 +1711,10 @@ mod tests {
         };
         assert_eq!(diag(&parsed.mass), vec![1.0; nf]);
         let w: Vec<f64> = b.modes.iter().map(|m| m.frequency_rad_s).collect();
-        assert_eq!(diag(&parsed.stiffness), w.iter().map(|w| w * w).collect::<Vec<_>>());
+        assert_eq!(
+            diag(&parsed.stiffness),
+            w.iter().map(|w| w * w).collect::<Vec<_>>()
+        );
         let c: Vec<f64> = b
             .modes
             .iter()
@@ -1814,11 +1839,18 @@ Hand Model                           ! Description
         bad.replace_range(start..start + 5, "0 0 3");
         assert!(matches!(
             read_flex_file(&bad),
-            Err(Flex42Error::IndexOutOfRange { what: "axis", index: 3, .. })
+            Err(Flex42Error::IndexOutOfRange {
+                what: "axis",
+                index: 3,
+                ..
+            })
         ));
         // A number that is not one.
         let nan = text.replacen("1e0 ", "nan ", 1);
-        assert!(matches!(read_flex_file(&nan), Err(Flex42Error::Parse { .. })));
+        assert!(matches!(
+            read_flex_file(&nan),
+            Err(Flex42Error::Parse { .. })
+        ));
     }
 
     #[test]
@@ -1829,19 +1861,29 @@ Hand Model                           ! Description
             f(&mut b);
             flex_file(&b).unwrap_err()
         };
-        assert!(matches!(with(&|b| b.name = "a b".into()), Flex42Error::BadName { .. }));
+        assert!(matches!(
+            with(&|b| b.name = "a b".into()),
+            Flex42Error::BadName { .. }
+        ));
         assert!(matches!(
             with(&|b| b.name = "n".repeat(31)),
             Flex42Error::BadName { .. }
         ));
-        assert!(matches!(with(&|b| b.modes.clear()), Flex42Error::NoModes { .. }));
+        assert!(matches!(
+            with(&|b| b.modes.clear()),
+            Flex42Error::NoModes { .. }
+        ));
         assert!(matches!(
             with(&|b| b.modes[0].damping_ratio = 1.0),
             Flex42Error::OutOfRange { value, .. } if value == 1.0
         ));
         assert!(matches!(
             with(&|b| b.mass_points[0].psi.push([0.0; 3])),
-            Flex42Error::ModeCount { expected: 2, found: 3, .. }
+            Flex42Error::ModeCount {
+                expected: 2,
+                found: 3,
+                ..
+            }
         ));
         assert!(matches!(
             with(&|b| b.nodes[0].position_m[1] = f64::NAN),
@@ -1876,7 +1918,10 @@ Hand Model                           ! Description
         // J_xy = −m x y = −4; 42's file holds ∫ x y dm = 4.
         assert_eq!(i.inertia_kg_m2[0][1], -4.0);
         let lines = i.sc_mass_lines();
-        assert!(lines.contains("\n4e0 0e0 0e0  ! Products of Inertia"), "{lines}");
+        assert!(
+            lines.contains("\n4e0 0e0 0e0  ! Products of Inertia"),
+            "{lines}"
+        );
         assert_eq!(i.mass_centre_m(), [1.0, 2.0, 0.0]);
     }
 }

@@ -3,8 +3,8 @@
 
 mod atomic;
 mod deploy;
-pub mod flex42;
 pub(crate) mod figures;
+pub mod flex42;
 mod modes;
 mod names;
 pub(crate) mod plot;
