@@ -6,6 +6,7 @@ mod atomic;
 mod deploy;
 mod export;
 pub(crate) mod figures;
+pub mod flex42;
 mod modes;
 mod names;
 pub(crate) mod plot;
