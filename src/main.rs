@@ -278,6 +278,11 @@ fn run_export(c: &Common) -> Result<(), ExitCode> {
         ExitCode::from(REFUSED)
     })?;
     let st = &scenario.structure;
+    let body = output::flex_body_name(
+        &path
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+    );
     finish(
         json,
         || output::export_json(st, &modes, &ex, &settings.transfers),
@@ -286,7 +291,8 @@ fn run_export(c: &Common) -> Result<(), ExitCode> {
         |d| {
             output::write_export(
                 d,
-                st,
+                &model,
+                &body,
                 &modes,
                 &ex,
                 &settings.transfers,

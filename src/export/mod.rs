@@ -16,8 +16,10 @@
 //! - Damping: modal (proportional) damping ζ_j on the elastic modes, none on rigid ones; in
 //!   physical coordinates C_q = M Φ diag(2ζω) Φᵀ M when every mode is kept.
 
+pub mod mass;
 pub mod points;
 
+pub use mass::{mass_elements, MassElement};
 pub use points::{point_jacobian, point_motion, point_position, NamedPoint, PointLocation};
 
 use crate::math::Vec3;

@@ -2,10 +2,18 @@
 //! frequency response (frequency_response.csv, plots/bode.{png,svg}) and the terminal
 //! summary. Conventions: docs/export.md.
 
+use super::flex42::{
+    flex_file, flex_file_name, nodes_file, nodes_file_name, Flex42Error, FlexBody, FlexMode,
+    FlexNode, MassPoint,
+};
 use super::names::csv_bytes;
 use super::{num, ArrayValue, OutputDir, OutputError};
-use crate::export::{transfer_unit, ExportModel, PointLocation, Transfer};
+use crate::export::{
+    mass_elements, point_motion, point_position, transfer_unit, ExportModel, PointLocation,
+    Transfer,
+};
 use crate::ritz::ModalAnalysis;
+use crate::ritz::RitzModel;
 use crate::structure::{HubMotion, Structure};
 use faer::Mat;
 use serde_json::{json, Value};
@@ -350,6 +358,92 @@ pub fn export_arrays(
     ]
 }
 
+/// A name 42 accepts for the flexible body (its file names): the letters, digits, `_` and `-`
+/// of `stem` (others become `_`), at most 30 bytes; "spacecraft" when nothing is left.
+pub fn flex_body_name(stem: &str) -> String {
+    let s: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(30)
+        .collect();
+    if s.trim_matches('_').is_empty() {
+        "spacecraft".to_string()
+    } else {
+        s
+    }
+}
+
+/// The structure as NASA 42 sees it: one flexible body whose modes are the hub-fixed modes
+/// kept by the export (the hub is its rigid core, the reference point the hub's reference
+/// point), discretised into mass elements for the modal integrals, with the hub's reference
+/// point and the named points as analysis nodes. `None` when no elastic mode is kept.
+fn flex_body(
+    model: &RitzModel,
+    modes: &ModalAnalysis,
+    ex: &ExportModel,
+    name: &str,
+) -> Option<FlexBody> {
+    let elastic: Vec<&crate::export::ExportMode> = ex.modes.iter().filter(|m| !m.rigid).collect();
+    let kept = elastic.len().min(modes.hub_fixed.len());
+    if kept == 0 {
+        return None;
+    }
+    let shapes: Vec<&[f64]> = modes.hub_fixed[..kept]
+        .iter()
+        .map(|h| h.shape.as_slice())
+        .collect();
+    let arr = |v: crate::math::Vec3| v.0;
+    let mat = |m: crate::math::Mat3| m.0;
+    let mass_points = mass_elements(model, &shapes)
+        .into_iter()
+        .map(|e| MassPoint {
+            position_m: arr(e.position),
+            mass_kg: e.mass,
+            inertia_kg_m2: mat(e.inertia),
+            psi: e.motion.iter().map(|m| arr(m.0)).collect(),
+            theta: e.motion.iter().map(|m| arr(m.1)).collect(),
+        })
+        .collect();
+    let sites = std::iter::once(("hub".to_string(), crate::export::points::HUB_REFERENCE))
+        .chain(ex.points.iter().map(|p| (p.name.clone(), p.location)));
+    let nodes = sites
+        .map(|(n, loc)| {
+            let motion: Vec<_> = shapes
+                .iter()
+                .map(|q| point_motion(model, &loc, q))
+                .collect();
+            FlexNode {
+                name: n,
+                position_m: arr(point_position(&model.structure, &loc)),
+                psi: motion.iter().map(|m| arr(m.0)).collect(),
+                theta: motion.iter().map(|m| arr(m.1)).collect(),
+            }
+        })
+        .collect();
+    Some(FlexBody {
+        name: name.to_string(),
+        modes: modes.hub_fixed[..kept]
+            .iter()
+            .zip(&elastic)
+            .map(|(h, e)| FlexMode {
+                frequency_rad_s: h.omega_rad_s,
+                damping_ratio: e.damping_ratio,
+                initial_displacement: 0.0,
+                initial_rate: 0.0,
+            })
+            .collect(),
+        mass_points,
+        joints: Vec::new(),
+        nodes,
+    })
+}
+
 /// Units and conventions, one line (the array files' `units` text).
 const UNITS: &str = "SI: Hz, rad/s, kg, m, rad, N, N m; mode shapes mass-normalised (m/sqrt(kg), \
 rad/sqrt(kg)); structure (hub) frame, hub inputs/outputs at its reference point; docs/export.md";
@@ -384,17 +478,26 @@ fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io
     })
 }
 
-/// Writes model.json, frequency_response.csv and plots/bode.{png,svg}.
+/// Writes model.json, model.npz, model.mat, NASA 42's flex_BODY.txt and nodes_BODY.txt
+/// ([`flex_body_name`]), frequency_response.csv and plots/bode.{png,svg}.
+#[allow(clippy::too_many_arguments)]
 pub fn write_export(
     dir: &mut OutputDir,
-    st: &Structure,
+    model: &RitzModel,
+    body: &str,
     modes: &ModalAnalysis,
     ex: &ExportModel,
     transfers: &[Transfer],
     range_hz: Option<(f64, f64)>,
     points: usize,
 ) -> Result<(), OutputError> {
+    let st = &model.structure;
     dir.write("model.json", export_json(st, modes, ex, transfers) + "\n")?;
+    if let Some(b) = flex_body(model, modes, ex, body) {
+        let bad42 = |e: Flex42Error| OutputError::Io(std::io::Error::other(e.to_string()));
+        dir.write(&flex_file_name(&b.name), flex_file(&b).map_err(bad42)?)?;
+        dir.write(&nodes_file_name(&b.name), nodes_file(&b).map_err(bad42)?)?;
+    }
     let arrays = export_arrays(st, modes, ex);
     let bad = |e: super::ArrayFileError| OutputError::Io(std::io::Error::other(e.to_string()));
     dir.write("model.npz", super::npz_bytes(&arrays).map_err(bad)?)?;

@@ -546,3 +546,90 @@ fn export_files_load_in_numpy_and_scipy() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// NASA 42's flex file, read back in 42's reading order, against a second formulation: its
+/// modal integrals are sums over quadrature points of the continuum (and the rigid bodies),
+/// while the participation matrix comes from the Ritz mass matrix, φᵀ M_{e,d}. The two must
+/// agree: Pf_p = ∫Ψ_p dm is the translational participation, and Hf_p = ∫ r × Ψ_p dm about the
+/// reference point is the rotational participation (about the hub's centre of mass c) plus
+/// c × Pf_p. Mf is the identity, Kf = diag(ω²) of the hub-fixed modes, and the node file lists
+/// the hub and the named points where they are.
+#[test]
+fn flex_file_integrals_agree_with_the_ritz_participation() {
+    use super::common::{bin, example, scratch};
+    use flexcraft::output::flex42::{read_flex_file, read_nodes_file};
+    let dir = scratch("export-42");
+    let out = bin()
+        .arg("export")
+        .arg(example("export.toml"))
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(dir.join("out/flex_export.txt")).unwrap();
+    let flex = read_flex_file(&text).expect("42 reads the flex file");
+    let nodes =
+        read_nodes_file(&std::fs::read_to_string(dir.join("out/nodes_export.txt")).unwrap())
+            .expect("42 reads the node file");
+    let (_, modes, ex, _) = build(include_str!("../../examples/export.toml"));
+    let nf = flex.pf.len();
+    assert_eq!(nf, 12);
+    let c = scenario(include_str!("../../examples/export.toml"))
+        .structure
+        .hub()
+        .center_of_mass();
+    let scale = (0..nf)
+        .flat_map(|p| (0..6).map(move |d| (p, d)))
+        .map(|(p, d)| ex.participation[(d, p)].abs())
+        .fold(0.0, f64::max);
+    for p in 0..nf {
+        let l = &modes.hub_fixed[p].participation;
+        let pf = flex.pf[p];
+        for a in 0..3 {
+            assert!(
+                (pf[a] - l[a]).abs() <= 1e-9 * scale,
+                "Pf[{p}][{a}] {} vs L {}",
+                pf[a],
+                l[a]
+            );
+        }
+        // c × Pf
+        let cx = [
+            c.get(1) * pf[2] - c.get(2) * pf[1],
+            c.get(2) * pf[0] - c.get(0) * pf[2],
+            c.get(0) * pf[1] - c.get(1) * pf[0],
+        ];
+        for a in 0..3 {
+            let want = l[3 + a] + cx[a];
+            assert!(
+                (flex.hf[p][a] - want).abs() <= 1e-9 * scale.max(1.0) * 10.0,
+                "Hf[{p}][{a}] {} vs {want}",
+                flex.hf[p][a]
+            );
+        }
+    }
+    for e in &flex.mass {
+        let want = if e.row == e.col { 1.0 } else { 0.0 };
+        assert!(
+            (e.value - want).abs() <= 1e-9,
+            "Mf[{}][{}] = {}",
+            e.row,
+            e.col,
+            e.value
+        );
+    }
+    for e in &flex.stiffness {
+        if e.row == e.col {
+            let w = modes.hub_fixed[e.row].omega_rad_s;
+            assert!((e.value - w * w).abs() <= 1e-12 * w * w);
+        }
+    }
+    let names: Vec<&str> = nodes.iter().map(|n| n.comment.as_str()).collect();
+    assert_eq!(names, ["hub", "star_tracker", "mast_tip", "wing_tip"]);
+    assert_eq!(nodes[3].position_m, [15.0, 0.0, 13.0]);
+}
