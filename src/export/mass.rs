@@ -14,8 +14,9 @@
 use super::points::{point_motion, point_position, PointLocation};
 use crate::basis::quadrature::Quadrature;
 use crate::math::{Mat3, Vec3};
-use crate::ritz::shapes::{beam_point, plate_point};
+use crate::ritz::shapes::{attachment_of, BeamStation, PlatePoint};
 use crate::ritz::RitzModel;
+use crate::structure::ComponentId;
 
 /// Panels of the composite rules.
 const PANELS: usize = 4;
@@ -58,13 +59,24 @@ pub fn mass_elements(model: &RitzModel, shapes: &[&[f64]]) -> Vec<MassElement> {
             })
             .collect(),
     });
+    // Basis values at each point are computed once, each attachment's motion once per shape.
+    let attachments = |id: ComponentId| -> Vec<(Vec3, Vec3)> {
+        shapes
+            .iter()
+            .map(|q| attachment_of(model, id, q).unwrap_or((Vec3::ZERO, Vec3::ZERO)))
+            .collect()
+    };
     for (i, b) in st.beams.iter().enumerate() {
         let t = b.terms;
         let rule = Quadrature::composite(PANELS, t.bending.max(t.torsion).max(t.axial) + EXTRA);
         let mu = b.mass_per_length();
         let rho_ip = b.density * b.section.polar_inertia;
         let ex = b.frame.ex;
+        let att = attachments(ComponentId::Beam(i));
         for (&xi, &w) in rule.points.iter().zip(&rule.weights) {
+            let Some(station) = BeamStation::new(model, i, xi) else {
+                continue;
+            };
             let dl = w * b.length;
             out.push(MassElement {
                 position: point_position(
@@ -78,9 +90,10 @@ pub fn mass_elements(model: &RitzModel, shapes: &[&[f64]]) -> Vec<MassElement> {
                 inertia: ex.outer(ex) * (rho_ip * dl),
                 motion: shapes
                     .iter()
-                    .map(|q| {
-                        beam_point(model, i, xi, q)
-                            .map_or((Vec3::ZERO, Vec3::ZERO), |p| (p.displacement, p.rotation))
+                    .zip(&att)
+                    .map(|(q, a)| {
+                        let p = station.sample(model, q, *a);
+                        (p.displacement, p.rotation)
                     })
                     .collect(),
             });
@@ -90,17 +103,22 @@ pub fn mass_elements(model: &RitzModel, shapes: &[&[f64]]) -> Vec<MassElement> {
         let rx = Quadrature::composite(PANELS, p.terms.length + EXTRA);
         let ry = Quadrature::composite(PANELS, p.terms.width + EXTRA);
         let area = p.length * p.width;
+        let att = attachments(ComponentId::Plate(i));
         for (&xi, &wx) in rx.points.iter().zip(&rx.weights) {
             for (&eta, &wy) in ry.points.iter().zip(&ry.weights) {
+                let Some(point) = PlatePoint::new(model, i, xi, eta) else {
+                    continue;
+                };
                 out.push(MassElement {
                     position: point_position(st, &PointLocation::Plate { plate: i, xi, eta }),
                     mass: p.areal_density * area * wx * wy,
                     inertia: Mat3::default(),
                     motion: shapes
                         .iter()
-                        .map(|q| {
-                            plate_point(model, i, xi, eta, q)
-                                .map_or((Vec3::ZERO, Vec3::ZERO), |s| (s.displacement, s.rotation))
+                        .zip(&att)
+                        .map(|(q, a)| {
+                            let s = point.sample(model, q, *a);
+                            (s.displacement, s.rotation)
                         })
                         .collect(),
                 });

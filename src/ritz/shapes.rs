@@ -34,45 +34,76 @@ pub fn sample_beam(model: &RitzModel, beam: usize, q: &[f64], n: usize) -> Vec<P
         .collect()
 }
 
+/// The basis values of a beam's three fields at one station, computed once and reused for
+/// many coordinate vectors ([`BeamStation::sample`]).
+#[derive(Debug, Clone)]
+pub struct BeamStation {
+    beam: usize,
+    xi: f64,
+    axial: Vec<crate::basis::Derivs>,
+    bending: Vec<crate::basis::Derivs>,
+    torsion: Vec<crate::basis::Derivs>,
+}
+
+impl BeamStation {
+    /// Beam `beam` at ξ = x/L ∈ [0, 1]; `None` for a beam the model does not have.
+    pub fn new(model: &RitzModel, beam: usize, xi: f64) -> Option<Self> {
+        let e = model.element(ComponentId::Beam(beam))?;
+        let ElementKind::Beam {
+            axial,
+            bending,
+            torsion,
+            ..
+        } = &e.kind
+        else {
+            return None;
+        };
+        Some(Self {
+            beam,
+            xi,
+            axial: axial.eval_vec(xi),
+            bending: bending.eval_vec(xi),
+            torsion: torsion.eval_vec(xi),
+        })
+    }
+
+    /// The section's displacement and small rotation (twist included) for coordinates q,
+    /// given the motion (u₀, θ₀) of the beam's attachment section for the same q
+    /// ([`attachment_of`]).
+    pub fn sample(&self, model: &RitzModel, q: &[f64], attachment: (Vec3, Vec3)) -> PointSample {
+        let e = model
+            .element(ComponentId::Beam(self.beam))
+            .expect("a BeamStation is made for a beam of this model");
+        let b = &model.structure.beams[self.beam];
+        let f = b.frame;
+        let (u0, th0) = attachment;
+        let coeff = |kind: FieldKind| &q[e.field(kind)];
+        let x = self.xi * b.length;
+        let sum = |vals: &[crate::basis::Derivs], c: &[f64], d: usize| -> f64 {
+            vals.iter().zip(c).map(|(v, ci)| v[d] * ci).sum()
+        };
+        let u = sum(&self.axial, coeff(FieldKind::U), 0);
+        let v = sum(&self.bending, coeff(FieldKind::V), 0);
+        let w = sum(&self.bending, coeff(FieldKind::W), 0);
+        let dv = sum(&self.bending, coeff(FieldKind::V), 1) / b.length;
+        let dw = sum(&self.bending, coeff(FieldKind::W), 1) / b.length;
+        let th = sum(&self.torsion, coeff(FieldKind::Theta), 0);
+        let r = f.ex * x;
+        PointSample {
+            local: [x, 0.0],
+            position: e.origin + r,
+            displacement: u0 + th0.cross(r) + f.ex * u + f.ey * v + f.ez * w,
+            rotation: th0 + f.ex * th - f.ey * dw + f.ez * dv,
+        }
+    }
+}
+
 /// The section of beam `beam` at ξ = x/L ∈ [0, 1]: its displacement and small rotation
 /// (twist included) for coordinates q. `None` for a beam the model does not have.
 pub fn beam_point(model: &RitzModel, beam: usize, xi: f64, q: &[f64]) -> Option<PointSample> {
-    let e = model.element(ComponentId::Beam(beam))?;
-    let ElementKind::Beam {
-        axial,
-        bending,
-        torsion,
-        ..
-    } = &e.kind
-    else {
-        return None;
-    };
-    let b = &model.structure.beams[beam];
-    let f = b.frame;
-    let (u0, th0) = attachment_motion(e, q);
-    let coeff = |kind: FieldKind| &q[e.field(kind)];
-    let x = xi * b.length;
-    let sum = |basis: &dyn crate::basis::Basis1d, c: &[f64], d: usize| -> f64 {
-        basis
-            .eval_vec(xi)
-            .iter()
-            .zip(c)
-            .map(|(v, ci)| v[d] * ci)
-            .sum()
-    };
-    let u = sum(axial.as_ref(), coeff(FieldKind::U), 0);
-    let v = sum(bending.as_ref(), coeff(FieldKind::V), 0);
-    let w = sum(bending.as_ref(), coeff(FieldKind::W), 0);
-    let dv = sum(bending.as_ref(), coeff(FieldKind::V), 1) / b.length;
-    let dw = sum(bending.as_ref(), coeff(FieldKind::W), 1) / b.length;
-    let th = sum(torsion.as_ref(), coeff(FieldKind::Theta), 0);
-    let r = f.ex * x;
-    Some(PointSample {
-        local: [x, 0.0],
-        position: e.origin + r,
-        displacement: u0 + th0.cross(r) + f.ex * u + f.ey * v + f.ez * w,
-        rotation: th0 + f.ex * th - f.ey * dw + f.ez * dv,
-    })
+    let station = BeamStation::new(model, beam, xi)?;
+    let att = attachment_of(model, ComponentId::Beam(beam), q)?;
+    Some(station.sample(model, q, att))
 }
 
 /// The displacement and rotation of the attachment section of a component (the hub's or a
@@ -96,6 +127,67 @@ pub fn sample_plate(
         .collect()
 }
 
+/// The basis values of a plate's deflection at one point (ξ, η), computed once and reused for
+/// many coordinate vectors ([`PlatePoint::sample`]).
+#[derive(Debug, Clone)]
+pub struct PlatePoint {
+    plate: usize,
+    xi: f64,
+    eta: f64,
+    x: Vec<crate::basis::Derivs>,
+    y: Vec<crate::basis::Derivs>,
+}
+
+impl PlatePoint {
+    /// Plate `plate` at (ξ, η) ∈ [0, 1]² (ξ along the length from the root edge, η across the
+    /// width); `None` for a plate the model does not have.
+    pub fn new(model: &RitzModel, plate: usize, xi: f64, eta: f64) -> Option<Self> {
+        let e = model.element(ComponentId::Plate(plate))?;
+        let ElementKind::Plate { length, width, .. } = &e.kind else {
+            return None;
+        };
+        Some(Self {
+            plate,
+            xi,
+            eta,
+            x: length.eval_vec(xi),
+            y: width.eval_vec(eta),
+        })
+    }
+
+    /// The point's displacement and the small rotation of its normal for coordinates q,
+    /// given the motion (u₀, θ₀) of the plate's attachment for the same q.
+    pub fn sample(&self, model: &RitzModel, q: &[f64], attachment: (Vec3, Vec3)) -> PointSample {
+        let e = model
+            .element(ComponentId::Plate(self.plate))
+            .expect("a PlatePoint is made for a plate of this model");
+        let p = &model.structure.plates[self.plate];
+        let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
+        let (u0, th0) = attachment;
+        let g = &q[e.field(FieldKind::G)];
+        let nyb = self.y.len();
+        let (mut w, mut wx, mut wy) = (0.0, 0.0, 0.0);
+        for (m, xm) in self.x.iter().enumerate() {
+            for (nidx, yn) in self.y.iter().enumerate() {
+                let c = g[m * nyb + nidx];
+                w += c * xm[0] * yn[0];
+                wx += c * xm[1] * yn[0];
+                wy += c * xm[0] * yn[1];
+            }
+        }
+        let (x, y) = (self.xi * p.length, (self.eta - 0.5) * p.width);
+        let r = ea * x + eb * y;
+        // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
+        let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
+        PointSample {
+            local: [x, y],
+            position: e.origin + r,
+            displacement: u0 + th0.cross(r) + nn * w,
+            rotation: rot,
+        }
+    }
+}
+
 /// The point (ξ, η) ∈ [0, 1]² of plate `plate` (ξ along the length from the root edge, η
 /// across the width): its displacement and the small rotation of its normal for
 /// coordinates q. `None` for a plate the model does not have.
@@ -106,36 +198,9 @@ pub fn plate_point(
     eta: f64,
     q: &[f64],
 ) -> Option<PointSample> {
-    let e = model.element(ComponentId::Plate(plate))?;
-    let ElementKind::Plate { length, width, .. } = &e.kind else {
-        return None;
-    };
-    let p = &model.structure.plates[plate];
-    let (ea, eb, nn) = (p.length_axis, p.width_axis(), p.normal);
-    let (u0, th0) = attachment_motion(e, q);
-    let g = &q[e.field(FieldKind::G)];
-    let nyb = width.len();
-    let yv = width.eval_vec(eta);
-    let xv = length.eval_vec(xi);
-    let (mut w, mut wx, mut wy) = (0.0, 0.0, 0.0);
-    for (m, xm) in xv.iter().enumerate() {
-        for (nidx, yn) in yv.iter().enumerate() {
-            let c = g[m * nyb + nidx];
-            w += c * xm[0] * yn[0];
-            wx += c * xm[1] * yn[0];
-            wy += c * xm[0] * yn[1];
-        }
-    }
-    let (x, y) = (xi * p.length, (eta - 0.5) * p.width);
-    let r = ea * x + eb * y;
-    // Small rotation of the normal: ∂W/∂x about −e_b, ∂W/∂y about e_a.
-    let rot = th0 + eb * (-wx / p.length) + ea * (wy / p.width);
-    Some(PointSample {
-        local: [x, y],
-        position: e.origin + r,
-        displacement: u0 + th0.cross(r) + nn * w,
-        rotation: rot,
-    })
+    let point = PlatePoint::new(model, plate, xi, eta)?;
+    let att = attachment_of(model, ComponentId::Plate(plate), q)?;
+    Some(point.sample(model, q, att))
 }
 
 /// Translation of the hub's centre of mass and its small rotation, for q over all
