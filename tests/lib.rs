@@ -17,6 +17,7 @@ mod suite {
     pub mod exact_beams;
     pub mod hardening_input;
     pub mod hardening_output;
+    pub mod implicit;
     pub mod modal_properties;
     pub mod mutations;
     pub mod output_dir;
