@@ -19,6 +19,7 @@ mod suite {
     pub mod export;
     pub mod hardening_input;
     pub mod hardening_output;
+    pub mod implicit;
     pub mod modal_properties;
     pub mod mutations;
     pub mod output_dir;

@@ -86,6 +86,17 @@ impl Hinge {
             - self.friction * (rate / FRICTION_RATE).clamp(-1.0, 1.0)
     }
 
+    /// The slopes of [`Hinge::moment`]: (∂/∂α, ∂/∂α̇) = (−k, −c − μ/ε inside the friction's
+    /// linear band |α̇| < ε, −c outside).
+    pub fn moment_slopes(&self, rate: f64) -> (f64, f64) {
+        let friction = if rate.abs() < FRICTION_RATE {
+            self.friction / FRICTION_RATE
+        } else {
+            0.0
+        };
+        (-self.stiffness, -self.damping - friction)
+    }
+
     /// Spring energy ½ k (α_ref − α)², J.
     pub fn energy(&self, alpha: f64) -> f64 {
         0.5 * self.stiffness * (self.reference_angle - alpha).powi(2)

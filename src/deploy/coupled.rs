@@ -78,6 +78,9 @@ pub struct Coupled {
     pub sync: Synchronisation,
     /// Compliant latches (`None`: rigid latches, plastic impacts).
     pub latch: Option<CompliantLatch>,
+    /// ζ of the base's modal damping (`[deployment] base_damping_ratio`, 0 by default): the
+    /// force −2 ζ ω_j η̇_j on each kept hub-fixed mode.
+    pub base_damping_ratio: f64,
 }
 
 /// A state split into its parts (slices of y = [positions, speeds]).
@@ -410,6 +413,12 @@ impl Coupled {
         refill(force, ns, 0.0);
         for k in 0..m {
             force[h + k] = -base.omega[k].powi(2) * s.eta[k];
+        }
+        if self.base_damping_ratio > 0.0 {
+            // Modal damping of the base (an option; zero by default): −2 ζ ω_j η̇_j.
+            for k in 0..m {
+                force[h + k] -= self.modal_damping(k) * s.eta_dot[k];
+            }
         }
         for (i, hg) in self.chain.hinges.iter().enumerate() {
             force[nb + i] = hg.moment(s.alpha[i], s.alpha_dot[i]);
@@ -866,6 +875,135 @@ impl Coupled {
     }
 }
 
+impl Coupled {
+    /// The stiff part of the Jacobian ∂f/∂y of [`Coupled::rhs_captured`] into `jac` (zeroed,
+    /// positions + speeds square), for the implicit integrator ([`super::rosenbrock`]).
+    ///
+    /// f = [ẏ_pos; u̇] with u̇ = Z (ZᵀMZ)⁻¹ Zᵀ (Q − c). Kept exactly: the kinematic rows
+    /// (η̇ and α̇ from the speeds, Ṙ = A(q) v, q̇ = ½ q ⊗ ω) and the applied forces' slopes
+    /// through the admissible inverse at y,
+    ///   ∂u̇/∂x ≈ Z (ZᵀMZ)⁻¹ Zᵀ ∂Q/∂x,
+    /// with ∂Q/∂η = −diag(ω_j²) and ∂Q/∂η̇ = −diag(2 ζ ω_j) (the base's stiffness and modal
+    /// damping, up to kHz: the stiff block), the hinge springs, dampers and regularised
+    /// friction, the elastic cable and the captured latches' k_L and c_L. Left out: the
+    /// configuration dependence of M and c, ∂(M⁻¹)/∂q (Q − c), and ∂c/∂u — terms of the
+    /// order of the slow motion's rates (the panels' and the hub's), which a step set by that
+    /// motion resolves; the stepper's error control sees what leaving them out costs.
+    pub fn stiff_jacobian(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        jac: &mut faer::Mat<f64>,
+    ) {
+        let (np, ns) = (self.positions(), self.speeds());
+        let (h, m, n) = (self.hub_dof(), self.modes(), self.panels());
+        let nb = h + m;
+        let s = self.view(y);
+        let pe = if h == 6 { 7 } else { 0 };
+        // Kinematic rows.
+        if h == 6 {
+            let a = attitude::matrix(s.quat);
+            for i in 0..3 {
+                for j in 0..3 {
+                    jac[(i, np + j)] = a.get(i, j);
+                }
+            }
+            // Ṙ = A(q) v: ∂/∂q by differences of a 3 × 4 map (cheap, and not stiff).
+            let rd = a.apply(s.v);
+            for c in 0..4 {
+                let mut q = s.quat;
+                let d = 1e-7;
+                q[c] += d;
+                let r1 = attitude::matrix(q).apply(s.v);
+                for i in 0..3 {
+                    jac[(i, 3 + c)] = (r1.get(i) - rd.get(i)) / d;
+                }
+            }
+            // q̇ = ½ q ⊗ (0, ω): linear in q and in ω.
+            for c in 0..4 {
+                let mut e = [0.0; 4];
+                e[c] = 1.0;
+                let col = attitude::rate(e, s.w);
+                for i in 0..4 {
+                    jac[(3 + i, 3 + c)] = col[i];
+                }
+            }
+            for c in 0..3 {
+                let mut e = Vec3::ZERO;
+                e.0[c] = 1.0;
+                let col = attitude::rate(s.quat, e);
+                for i in 0..4 {
+                    jac[(3 + i, np + 3 + c)] = col[i];
+                }
+            }
+        }
+        for k in 0..m + n {
+            jac[(pe + k, np + h + k)] = 1.0;
+        }
+        // ∂Q/∂y as sparse columns: (column of y, [(row of Q, value)]).
+        let mut cols: Vec<(usize, Vec<(usize, f64)>)> = Vec::with_capacity(2 * (m + n));
+        for k in 0..m {
+            let w = self.base.omega[k];
+            cols.push((pe + k, vec![(h + k, -w * w)]));
+            cols.push((np + h + k, vec![(h + k, -self.modal_damping(k))]));
+        }
+        for (i, hg) in self.chain.hinges.iter().enumerate() {
+            let (mut ka, mut kr) = hg.moment_slopes(s.alpha_dot[i]);
+            if let Some(l) = &self.latch {
+                if captured.get(i).copied().unwrap_or(false) {
+                    ka -= l.stiffness[i];
+                    kr -= l.damping[i];
+                }
+            }
+            let mut col = vec![(nb + i, ka)];
+            if let Synchronisation::ElasticCable(kc) = self.sync {
+                // Q_α = −k_c Cᵀ C (α − α(0)): column i of −k_c CᵀC.
+                let rows = self.cable_rows();
+                for r in 0..n {
+                    let v: f64 = rows.iter().map(|c| c[r] * c[i]).sum();
+                    if r == i {
+                        col[0].1 -= kc * v;
+                    } else if v != 0.0 {
+                        col.push((nb + r, -kc * v));
+                    }
+                }
+            }
+            cols.push((pe + m + i, col));
+            cols.push((np + nb + i, vec![(nb + i, kr)]));
+        }
+        WORKSPACE.with_borrow_mut(|(ws, sw)| {
+            self.assemble(y, ws);
+            self.admissible_into(free, &mut sw.z);
+            let mass = &ws.mass;
+            let ok = factor_admissible(|i, j| mass[i * ns + j], sw);
+            let mut b = vec![0.0; ns];
+            let mut u = vec![0.0; ns];
+            for (c, entries) in &cols {
+                if entries.iter().all(|&(_, v)| v == 0.0) {
+                    continue;
+                }
+                b.fill(0.0);
+                for &(r, v) in entries {
+                    b[r] = v;
+                }
+                u.fill(if ok { 0.0 } else { f64::NAN });
+                if ok {
+                    solve_factored(&b, sw, &mut u);
+                }
+                for (r, ur) in u.iter().enumerate() {
+                    jac[(np + r, *c)] = *ur;
+                }
+            }
+        });
+    }
+
+    /// The base's modal damping coefficient of mode k, 2 ζ ω_k (1/s; zero when undamped).
+    fn modal_damping(&self, k: usize) -> f64 {
+        2.0 * self.base_damping_ratio * self.base.omega[k]
+    }
+}
+
 thread_local! {
     /// [`Coupled::rhs_captured`]'s buffers (resized whenever the model changes).
     static WORKSPACE: RefCell<(Workspace, SolveWork)> = RefCell::new(Default::default());
@@ -1100,12 +1238,22 @@ fn solve_admissible(
     work: &mut SolveWork,
     u: &mut [f64],
 ) {
-    let z = &work.z;
-    let k = z.len();
     u.fill(0.0);
-    if k == 0 {
+    if work.z.len() == 0 {
         return;
     }
+    if !factor_admissible(m, work) {
+        u.fill(f64::NAN);
+        return;
+    }
+    solve_factored(b, work, u);
+}
+
+/// ZᵀMZ (M by its entries `m(i, j)`, Z in `work.z`) and its Cholesky factor into
+/// `work.zmz`; false when it is not positive definite.
+fn factor_admissible(m: impl Fn(usize, usize) -> f64, work: &mut SolveWork) -> bool {
+    let z = &work.z;
+    let k = z.len();
     // Z is sparse (unit columns for the hub and base speeds and the free hinges, one cable
     // column): ZᵀMZ and Zᵀb by loops over its non-zeros, the lower triangle of ZᵀMZ only
     // (the factorisation reads no more).
@@ -1125,13 +1273,16 @@ fn solve_admissible(
             work.zmz[a * k + c] = v;
         }
     }
+    cholesky_in_place(&mut work.zmz, k)
+}
+
+/// u += Z (ZᵀMZ)⁻¹ Zᵀ b with the factor of [`factor_admissible`] in `work.zmz`.
+fn solve_factored(b: &[f64], work: &mut SolveWork, u: &mut [f64]) {
+    let z = &work.z;
+    let k = z.len();
     refill(&mut work.w, k, 0.0);
     for (a, wa) in work.w.iter_mut().enumerate() {
         *wa = z.column(a).iter().map(|&(j, zj)| zj * b[j]).sum::<f64>();
-    }
-    if !cholesky_in_place(&mut work.zmz, k) {
-        u.fill(f64::NAN);
-        return;
     }
     cholesky_solve(&work.zmz, k, &mut work.w);
     for (j, wj) in work.w.iter().enumerate() {

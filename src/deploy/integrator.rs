@@ -25,6 +25,13 @@
 pub trait OdeSystem {
     /// Writes f(t, y) into `dy`.
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]);
+    /// Writes an approximation of ∂f/∂y at (t, y) into `jac` (n × n, zeroed by the caller)
+    /// and returns true, or returns false when the system has none (an implicit stepper then
+    /// differences f). What "approximation" may leave out is the stepper's business: see
+    /// [`super::rosenbrock`].
+    fn jacobian(&self, _t: f64, _y: &[f64], _jac: &mut faer::Mat<f64>) -> bool {
+        false
+    }
 }
 
 const C2: f64 = 1.0 / 5.0;

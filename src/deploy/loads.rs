@@ -228,6 +228,16 @@ impl Engine for Coupled {
     fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
         self.rhs_captured(y, free, captured, dy);
     }
+    fn jacobian(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        jac: &mut faer::Mat<f64>,
+    ) -> bool {
+        self.stiff_jacobian(y, free, captured, jac);
+        true
+    }
     fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses) {
         let u = Coupled::impact(self, y, free_after);
         let hinges = self.hinge_impulses(y, &u);

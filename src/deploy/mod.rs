@@ -70,6 +70,10 @@ pub struct Deployment {
     pub integrator: Integrator,
     /// How hinges latch.
     pub latch: LatchModel,
+    /// ζ of a modal damping of the flexible base's kept modes during deployment
+    /// (`[deployment] base_damping_ratio`; 0, undamped, by default). A physical option, not
+    /// a numerical one: it changes the results.
+    pub base_damping_ratio: f64,
 }
 
 /// The time integrator of a deployment run.
@@ -512,6 +516,7 @@ impl Deployment {
                     damping: damping.clone(),
                 }),
             },
+            base_damping_ratio: self.base_damping_ratio,
         })
     }
 }

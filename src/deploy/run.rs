@@ -55,6 +55,17 @@ pub(crate) trait Engine {
     fn kinetic_energy(&self, y: &[f64]) -> f64;
     /// The sample at time t.
     fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample;
+    /// ∂(dy/dt)/∂y, or its stiff part, into `jac` (zeroed); false when the model has none
+    /// (see [`OdeSystem::jacobian`]).
+    fn jacobian(
+        &self,
+        _y: &[f64],
+        _free: &[bool],
+        _captured: &[bool],
+        _jac: &mut faer::Mat<f64>,
+    ) -> bool {
+        false
+    }
     /// Load magnitudes whose peaks the run tracks at every step ([`super::peaks`]); none by
     /// default.
     fn load_magnitudes(&self, _y: &[f64], _free: &[bool], _captured: &[bool]) -> Vec<f64> {
@@ -207,6 +218,9 @@ impl<E: Engine> System<'_, E> {
 impl<E: Engine> OdeSystem for System<'_, E> {
     fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
         self.engine.rhs(y, &self.free, &self.captured, dy);
+    }
+    fn jacobian(&self, _t: f64, y: &[f64], jac: &mut faer::Mat<f64>) -> bool {
+        self.engine.jacobian(y, &self.free, &self.captured, jac)
     }
 }
 

@@ -111,6 +111,7 @@ pub(super) fn lower(
             _ => Integrator::Explicit,
         },
         base: base(cx, raw)?,
+        base_damping_ratio: base_damping_ratio(cx, raw)?,
         synchronisation,
         plate: plate.name.clone(),
         chain,
@@ -222,6 +223,32 @@ fn base(cx: &Ctx, raw: &S<RawDeployment>) -> Result<BaseKind, ScenarioError> {
                 modes: Some(usize::try_from(k).unwrap_or(usize::MAX)),
             })
         }
+    }
+}
+
+/// `base_damping_ratio`: ζ in [0, 1) of the flexible base's modal damping, refused with a
+/// rigid base (it has no modes to damp). Absent: 0 (undamped; `[response] damping_ratio` is
+/// not inherited, so that no deployment result changes without the key).
+fn base_damping_ratio(cx: &Ctx, raw: &S<RawDeployment>) -> Result<f64, ScenarioError> {
+    let d = raw.get_ref();
+    let rigid = matches!(d.base.as_ref().map(|b| *b.get_ref()), Some(RawBase::Rigid));
+    match &d.base_damping_ratio {
+        None => Ok(0.0),
+        Some(z) if rigid => Err(cx.invalid(
+            z.span(),
+            "deployment.base_damping_ratio",
+            "a rigid base (base = \"rigid\") has no modes to damp: remove base_damping_ratio \
+             or set base = \"flexible\"",
+        )),
+        Some(z) if L::DAMPING_RATIO.contains(*z.get_ref()) => Ok(*z.get_ref()),
+        Some(z) => Err(cx.invalid(
+            z.span(),
+            "deployment.base_damping_ratio",
+            format!(
+                "must lie in [0, 1): below 1 (an underdamped structure), got {}",
+                z.get_ref()
+            ),
+        )),
     }
 }
 

@@ -180,6 +180,7 @@ pub struct RawDeployment {
     pub latching: Option<S<RawLatching>>,
     pub base: Option<S<RawBase>>,
     pub base_modes: Option<S<i64>>,
+    pub base_damping_ratio: Option<S<f64>>,
     pub synchronisation: Option<S<RawSynchronisation>>,
     pub cable_stiffness: Option<S<f64>>,
     pub integrator: Option<S<RawIntegrator>>,

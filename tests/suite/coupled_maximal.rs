@@ -1182,6 +1182,7 @@ fn rigid_mast_limit_agrees_with_the_rigid_chain() {
         synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
         integrator: flexcraft::deploy::Integrator::Explicit,
         latch: flexcraft::deploy::LatchModel::Rigid,
+        base_damping_ratio: 0.0,
         tolerance: 1e-12,
     });
     assert_eq!(

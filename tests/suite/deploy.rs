@@ -52,6 +52,7 @@ pub fn deployment(chain: Chain, latching: Latching, tol: f64) -> Deployment {
         synchronisation: flexcraft::deploy::coupled::Synchronisation::None,
         integrator: flexcraft::deploy::Integrator::Explicit,
         latch: flexcraft::deploy::LatchModel::Rigid,
+        base_damping_ratio: 0.0,
         tolerance: tol,
     }
 }

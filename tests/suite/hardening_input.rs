@@ -435,7 +435,7 @@ fn derived_panels_obey_the_ranges_of_given_ones() {
 fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
     let dir = scratch("coupled-keys");
     let sync = "synchronisation = \"cable\"\n";
-    let cases: [(String, &str, &str, &str); 6] = [
+    let cases: [(String, &str, &str, &str); 9] = [
         (
             SEED.replace(sync, &format!("{sync}hub = \"free\"\n")),
             "hub = \"free\"",
@@ -470,6 +470,24 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
             SEED.replace("base = \"flexible\"", "base = \"rigid\""),
             "base_modes = 6",
             "deployment.base_modes",
+            "rigid base",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}base_damping_ratio = 1.0\n")),
+            "base_damping_ratio = 1.0",
+            "deployment.base_damping_ratio",
+            "[0, 1)",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}base_damping_ratio = -0.01\n")),
+            "base_damping_ratio = -0.01",
+            "deployment.base_damping_ratio",
+            "[0, 1)",
+        ),
+        (
+            SEED.replace("base = \"flexible\"\nbase_modes = 6", "base = \"rigid\"\nbase_damping_ratio = 0.01"),
+            "base_damping_ratio = 0.01",
+            "deployment.base_damping_ratio",
             "rigid base",
         ),
     ];
