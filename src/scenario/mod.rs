@@ -12,6 +12,7 @@ mod export;
 mod hub;
 mod masses;
 mod materials;
+mod overrides;
 mod plates;
 mod raw;
 mod response;
@@ -20,6 +21,7 @@ mod ritz;
 pub use budget::{format_bytes, Estimate};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
 pub use error::{ErrorKind, Location, ScenarioError};
+pub use overrides::{apply_overrides, OverrideValue};
 
 use crate::deploy::Deployment;
 use crate::response::ResponseSettings;
