@@ -17,6 +17,7 @@ pub mod planar;
 pub(crate) mod rosenbrock;
 mod run;
 pub mod swing;
+pub mod sweep;
 
 use crate::ritz::RitzError;
 use crate::structure::Structure;

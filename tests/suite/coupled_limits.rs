@@ -1576,3 +1576,70 @@ fn rigid_base_with_a_free_3d_hub_agrees_with_maximal_coordinates() {
         started.elapsed()
     );
 }
+
+// ---------------------------------------------------------------------------------------
+// 5. Modes along the deployment (`deploy::sweep`)
+// ---------------------------------------------------------------------------------------
+
+/// The sweep's frozen-configuration modes at the latched, straight state are the modes of the
+/// mast with a rigid wing (the Ritz model of the structure with the plate's coordinates
+/// removed, as in test 1): every hinge rigid, the held hub.
+#[test]
+fn sweep_modes_at_the_latched_state_are_those_of_the_mast_with_a_rigid_wing() {
+    use flexcraft::deploy::sweep::linear_frequencies;
+    let sc = parse(&mast_and_wing("fixed", 1.0e4, 70e9), "sweep.toml");
+    let c = coupled(&sc, BaseKind::Flexible { modes: None });
+    let y = locked_straight(&c);
+    let n = c.panels();
+    let w = linear_frequencies(&c, &y, &vec![false; n], &vec![false; n]).expect("modes");
+    let exact = rigid_wing_ritz_frequencies(&sc);
+    assert_eq!(w.len(), exact.len());
+    for (i, (a, e)) in w.iter().zip(&exact).enumerate() {
+        assert!(rel(*a, *e) <= 1e-9, "mode {}: sweep {a} vs rigid-wing Ritz {e}", i + 1);
+    }
+}
+
+/// At a partly deployed state (every hinge half-way), panels on stiffer and stiffer hinge
+/// springs: the modes that stay finite converge to those of the array clamped at that
+/// configuration (every hinge rigid), with an error falling as 1/k (the springs' compliance);
+/// free hub, so the six rigid modes are left out of both.
+#[test]
+fn sweep_modes_on_stiff_hinges_converge_to_the_clamped_array() {
+    use flexcraft::deploy::sweep::linear_frequencies;
+    let sc = parse(&mast_and_wing("free", 1.0e4, 70e9), "sweep_free.toml");
+    let mut c = coupled(&sc, BaseKind::Flexible { modes: Some(8) });
+    assert_eq!(c.hub_dof(), 6);
+    let n = c.panels();
+    let mut y = c.initial_state();
+    let off = c.alpha_offset();
+    for (i, h) in c.chain.hinges.iter().enumerate() {
+        y[off + i] = 0.5 * (h.initial_angle + h.latch_angle);
+    }
+    let clamped = linear_frequencies(&c, &y, &vec![false; n], &vec![false; n]).unwrap();
+    assert_eq!(clamped.len(), 8);
+    let mut errors = Vec::new();
+    for k in [1e8, 1e10, 1e12] {
+        for h in &mut c.chain.hinges {
+            h.stiffness = k;
+        }
+        let w = linear_frequencies(&c, &y, &vec![true; n], &vec![false; n]).unwrap();
+        assert_eq!(w.len(), 8 + n);
+        // The clamped modes are the first 8 once the hinge modes (∝ √k) are above them.
+        let err = clamped
+            .iter()
+            .zip(&w)
+            .map(|(a, b)| rel(*b, *a))
+            .fold(0.0, f64::max);
+        // Springs add compliance: every frequency at or below the clamped one.
+        for (a, b) in clamped.iter().zip(&w) {
+            assert!(*b <= *a * (1.0 + 1e-10), "k = {k:e}: {b} above clamped {a}");
+        }
+        errors.push(err);
+    }
+    assert!(errors[2] < 1e-5, "k = 1e12: {}", sci(&errors));
+    assert!(
+        errors[1] < errors[0] / 50.0 && errors[2] < errors[1] / 50.0,
+        "1/k convergence: {}",
+        sci(&errors)
+    );
+}
