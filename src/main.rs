@@ -47,8 +47,18 @@ struct Common {
 enum Command {
     /// Natural frequencies and mode shapes of the deployed spacecraft (Rayleigh–Ritz).
     /// --out writes modes.json, frequencies.csv, coefficient and shape CSVs and plots.
+    /// With --deployment-sweep K, also the modes of the partly deployed spacecraft at K
+    /// states along the simulated deployment (and the stowed and final states):
+    /// deployment_modes.csv and plots/deployment_modes.{png,svg}.
     #[command(after_help = UNITS)]
-    Modes(#[command(flatten)] Common),
+    Modes {
+        #[command(flatten)]
+        common: Common,
+        /// Frequencies at K states evenly spaced in time along the deployment of [deployment]
+        /// (1 to 1000), plus the stowed and final states.
+        #[arg(long, value_name = "K", value_parser = clap::value_parser!(u16).range(1..=1000))]
+        deployment_sweep: Option<u16>,
+    },
     /// Deployment of the accordion-folded array in [deployment]: hinge springs, loads,
     /// latching with impact, hub disturbance. --out writes deployment.csv, events.json and
     /// plots.
@@ -81,7 +91,10 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let done = match cli.command {
-        Command::Modes(c) => run_modes(&c),
+        Command::Modes {
+            common,
+            deployment_sweep,
+        } => run_modes(&common, deployment_sweep.map(usize::from)),
         Command::Deploy(c) => run_deploy(&c),
         Command::Export(c) => run_export(&c),
         Command::Simulate {
@@ -231,7 +244,27 @@ fn finish(
     Ok(())
 }
 
-fn run_modes(c: &Common) -> Result<(), ExitCode> {
+/// The modes along the deployment (`modes --deployment-sweep K`): the coupled deployment
+/// of [deployment], then the frozen-configuration modes at K + 2 states.
+fn run_sweep(
+    c: &Common,
+    scenario: &Scenario,
+    k: usize,
+    count: usize,
+) -> Result<Vec<flexcraft::deploy::sweep::SweepState>, ExitCode> {
+    let path = c.scenario.as_path();
+    let d = need_deployment(path, scenario)?;
+    let fail = |e: &dyn std::fmt::Display| {
+        eprintln!("error: {}: {e}", path.display());
+        ExitCode::from(FAILED)
+    };
+    let (coupled, run) =
+        flexcraft::deploy::simulate_coupled(&scenario.structure, d).map_err(|e| fail(&e))?;
+    flexcraft::deploy::sweep::deployment_sweep(&coupled, &run, &coupled.initial_state(), k, count)
+        .map_err(|e| fail(&e))
+}
+
+fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let scenario = load(c)?;
     let staged = prepare(out, c.force)?;
@@ -243,12 +276,37 @@ fn run_modes(c: &Common) -> Result<(), ExitCode> {
         .map_err(|e| numerical_failure(&scenario, &model, &e))?
         .with_selection(selection);
     not_finite(path, flexcraft::finite::check_modes(&modes))?;
+    let count = modes.elastic().count().clamp(1, 10);
+    let states = match sweep {
+        Some(k) => Some(run_sweep(c, &scenario, k, count)?),
+        None => None,
+    };
     finish(
         json,
-        || output::modes_json(&model, &modes),
-        || output::modes_table(&scenario, &model, &modes),
+        || match &states {
+            None => output::modes_json(&model, &modes),
+            Some(s) => {
+                let mut v: serde_json::Value =
+                    serde_json::from_str(&output::modes_json(&model, &modes)).unwrap_or_default();
+                v["deployment_sweep"] = output::sweep_json(s);
+                serde_json::to_string_pretty(&v).unwrap_or_default()
+            }
+        },
+        || {
+            let mut t = output::modes_table(&scenario, &model, &modes);
+            if let Some(s) = &states {
+                t += &output::sweep_table(s);
+            }
+            t
+        },
         staged.zip(out),
-        |d| output::write_modes(d, &model, &modes),
+        |d| {
+            output::write_modes(d, &model, &modes)?;
+            match &states {
+                Some(s) => output::write_sweep(d, s),
+                None => Ok(()),
+            }
+        },
     )
 }
 

@@ -16,8 +16,8 @@ pub mod peaks;
 pub mod planar;
 pub(crate) mod rosenbrock;
 mod run;
-pub mod swing;
 pub mod sweep;
+pub mod swing;
 
 use crate::ritz::RitzError;
 use crate::structure::Structure;

@@ -34,7 +34,7 @@ pub struct SweepState {
 }
 
 /// The elastic circular frequencies [rad/s], ascending, of the coupled model frozen at
-/// positions `y` (the speeds part of `y` is ignored), with the hinges flagged `free` acting as
+/// positions `y` (the first [`Coupled::positions`] entries; any speeds after them are ignored), with the hinges flagged `free` acting as
 /// springs and the others rigid, and `captured` hinges held by their compliant latch spring.
 pub fn linear_frequencies(
     c: &Coupled,
@@ -42,8 +42,12 @@ pub fn linear_frequencies(
     free: &[bool],
     captured: &[bool],
 ) -> Result<Vec<f64>, RitzError> {
-    let ev = c.evaluate(y);
     let ns = c.speeds();
+    let np = c.positions();
+    // At rest: the positions of y, zero speeds (M does not depend on them).
+    let mut at_rest = y[..np].to_vec();
+    at_rest.resize(np + ns, 0.0);
+    let ev = c.evaluate(&at_rest);
     let (h, m, n) = (c.hub_dof(), c.modes(), c.panels());
     let nb = h + m;
     let mut k = Mat::<f64>::zeros(ns, ns);
@@ -73,13 +77,10 @@ pub fn linear_frequencies(
     let z = c.admissible(free);
     let mr = z.transpose() * &ev.mass * &z;
     let kr = z.transpose() * &k * &z;
-    let sym = |a: &Mat<f64>| Mat::from_fn(a.nrows(), a.ncols(), |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let sym =
+        |a: &Mat<f64>| Mat::from_fn(a.nrows(), a.ncols(), |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
     let (lambda, _) = generalized_symmetric(&sym(&kr), &sym(&mr))?;
-    Ok(lambda
-        .iter()
-        .skip(h)
-        .map(|l| l.max(0.0).sqrt())
-        .collect())
+    Ok(lambda.iter().skip(h).map(|l| l.max(0.0).sqrt()).collect())
 }
 
 /// The frequencies (at most `count` per state) at `k` states evenly spaced in time from
@@ -139,7 +140,11 @@ pub fn deployment_sweep(
         states.push(SweepState {
             time: t,
             progress: progress(&alpha),
-            latched: locked.iter().zip(&captured).map(|(a, b)| *a || *b).collect(),
+            latched: locked
+                .iter()
+                .zip(&captured)
+                .map(|(a, b)| *a || *b)
+                .collect(),
             alpha,
             frequencies_hz: w
                 .iter()
@@ -154,12 +159,7 @@ pub fn deployment_sweep(
     // hub components, so the identity attitude and the samples' η and α define the state).
     for s in 1..=k {
         let t = end * s as f64 / (k + 1) as f64;
-        let Some(sample) = run
-            .samples
-            .iter()
-            .take_while(|p| p.t <= t)
-            .last()
-        else {
+        let Some(sample) = run.samples.iter().take_while(|p| p.t <= t).last() else {
             continue;
         };
         let mut y = y0[..np].to_vec();

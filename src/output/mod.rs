@@ -13,6 +13,7 @@ pub(crate) mod plot;
 pub(crate) mod raster;
 mod report;
 mod simulate;
+mod sweep;
 #[cfg(test)]
 mod tests;
 pub(crate) mod view3d;
@@ -25,6 +26,7 @@ pub use modes::{modes_json, modes_table, write_modes};
 pub use names::file_stems;
 pub use report::report_html;
 pub use simulate::{simulate_json, simulate_table, write_simulate};
+pub use sweep::{sweep_json, sweep_table, write_sweep};
 
 use thiserror::Error;
 

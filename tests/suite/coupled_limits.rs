@@ -1595,7 +1595,11 @@ fn sweep_modes_at_the_latched_state_are_those_of_the_mast_with_a_rigid_wing() {
     let exact = rigid_wing_ritz_frequencies(&sc);
     assert_eq!(w.len(), exact.len());
     for (i, (a, e)) in w.iter().zip(&exact).enumerate() {
-        assert!(rel(*a, *e) <= 1e-9, "mode {}: sweep {a} vs rigid-wing Ritz {e}", i + 1);
+        assert!(
+            rel(*a, *e) <= 1e-9,
+            "mode {}: sweep {a} vs rigid-wing Ritz {e}",
+            i + 1
+        );
     }
 }
 

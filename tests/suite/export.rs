@@ -633,3 +633,61 @@ fn flex_file_integrals_agree_with_the_ritz_participation() {
     assert_eq!(names, ["hub", "star_tracker", "mast_tip", "wing_tip"]);
     assert_eq!(nodes[3].position_m, [15.0, 0.0, 13.0]);
 }
+
+/// `modes --deployment-sweep K`: K + 2 states in time order from release (progress 0, no
+/// hinge latched) to the fully latched array, whose frequencies are those of the frozen
+/// model with every hinge rigid — the same numbers the library gives for the run's final
+/// state; K = 0 and a scenario without [deployment] are refused with exit status 2.
+#[test]
+fn deployment_sweep_writes_k_plus_two_states() {
+    use super::common::{bin, example, scratch};
+    let dir = scratch("sweep");
+    let out = bin()
+        .args(["modes", "--deployment-sweep", "3", "--out"])
+        .arg(dir.join("out"))
+        .arg(example("seed.toml"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(dir.join("out/deployment_modes.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 1 + 5, "{csv}");
+    assert_eq!(rows[0][0], "t [s]");
+    let n = 3;
+    let latched = |r: &Vec<&str>| r[2 + n..2 + 2 * n].iter().all(|v| *v == "1");
+    assert_eq!(rows[1][1].parse::<f64>().unwrap(), 0.0);
+    assert!(!latched(&rows[1]) && latched(&rows[5]));
+    let times: Vec<f64> = rows[1..].iter().map(|r| r[0].parse().unwrap()).collect();
+    assert!(times.windows(2).all(|w| w[0] <= w[1]), "{times:?}");
+    // The final state by the library: the run's last state, every hinge rigid.
+    let s = scenario(include_str!("../../examples/seed.toml"));
+    let d = s.deployment.as_ref().unwrap();
+    let (c, run) = flexcraft::deploy::simulate_coupled(&s.structure, d).unwrap();
+    let w =
+        flexcraft::deploy::sweep::linear_frequencies(&c, &run.final_q, &[false; 3], &[false; 3])
+            .unwrap();
+    let f1: f64 = rows[5][2 + 2 * n].parse().unwrap();
+    assert!(
+        (f1 - w[0] / (2.0 * std::f64::consts::PI)).abs() <= 1e-12 * f1,
+        "{f1} vs {}",
+        w[0]
+    );
+    assert!(dir.join("out/plots/deployment_modes.svg").exists());
+    let out = bin()
+        .args(["modes", "--deployment-sweep", "0"])
+        .arg(example("seed.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "K = 0");
+    let out = bin()
+        .args(["modes", "--deployment-sweep", "2"])
+        .arg(example("composite.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no [deployment] section"));
+}
