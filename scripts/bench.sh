@@ -39,4 +39,16 @@ echo "the same with --out (CSV, JSON, 11 PNG+SVG plots), best of 5:"
 i=0
 while [ $i -lt 5 ]; do rm -rf target/bench-sim; best_of 1 ./target/release/flexcraft simulate examples/seed.toml --out target/bench-sim; i=$((i + 1)); done
 rm -rf target/bench-sim
+python3 - > target/seed-export.toml <<'PY'
+src = open("examples/seed.toml").read() + "\n[export]\nmodes = 50\n"
+for i in range(10):
+    src += f'[[export.points]]\nname = "p{i}"\ncomponent = "mast"\nstation = {i * 1.3}\n'
+print(src)
+PY
+echo "whole process, flexcraft export of the seed with 50 modes and 10 points, --out (best of 5):"
+i=0
+best=999999999
+while [ $i -lt 5 ]; do rm -rf target/bench-export; best_of 1 ./target/release/flexcraft export target/seed-export.toml --out target/bench-export; i=$((i + 1)); done
+rm -rf target/bench-export
+cargo bench --bench export 2>/dev/null | grep -E "^export/|time:"
 cargo bench --bench modes 2>/dev/null | grep -E "^(modes|deploy|response)/|time:"
