@@ -478,6 +478,26 @@ fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io
     })
 }
 
+/// The Bode curves of `transfers` over the export's frequency grid.
+pub(crate) fn bode_curves(
+    ex: &ExportModel,
+    transfers: &[Transfer],
+    range_hz: Option<(f64, f64)>,
+    points: usize,
+) -> Vec<super::plot::BodeCurve> {
+    let f = ex.frequency_grid(range_hz, points);
+    transfers
+        .iter()
+        .map(|t| {
+            let h = response_of(ex, t, &f);
+            (
+                format!("{} → {}", t.input, t.output),
+                f.iter().copied().zip(h).collect(),
+            )
+        })
+        .collect()
+}
+
 /// Writes model.json, model.npz, model.mat, NASA 42's flex_BODY.txt and nodes_BODY.txt
 /// ([`flex_body_name`]), frequency_response.csv and plots/bode.{png,svg}.
 #[allow(clippy::too_many_arguments)]

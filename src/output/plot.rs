@@ -526,6 +526,20 @@ pub fn bode_chart(
     Ok(())
 }
 
+/// The Bode plot of [`bode_chart`] as SVG text (for the report).
+pub fn bode_svg(title: &str, curves: &[BodeCurve]) -> Result<String, OutputError> {
+    register_font();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1000, 800)).into_drawing_area();
+        draw_bode(root, title, curves).map_err(|reason| OutputError::Plot {
+            file: "report: Bode plot".to_string(),
+            reason,
+        })?;
+    }
+    Ok(svg)
+}
+
 fn draw_bode<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,

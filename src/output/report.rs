@@ -359,7 +359,7 @@ fn view_section(s: &Scenario, sim: &Simulation) -> String {
     )
 }
 
-fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
+fn modes_section(s: &Scenario, sim: &Simulation) -> Result<String, OutputError> {
     let st = &sim.model.structure;
     let mut o = String::from("<section id=\"modes\"><h2>Modes</h2>\n");
     let _ = writeln!(
@@ -381,6 +381,7 @@ fn modes_section(sim: &Simulation) -> Result<String, OutputError> {
         hub_fixed_table(sim, &mut o);
     }
     mode_shapes(sim, &mut o)?;
+    bode_section(s, sim, &mut o)?;
     coefficient_tables(sim, &mut o);
     o.push_str("</section>\n");
     Ok(o)
@@ -513,6 +514,42 @@ fn hub_fixed_table(sim: &Simulation, o: &mut String) {
 }
 
 /// Mode shapes: the first six elastic modes.
+/// The frequency response of `[export]`'s transfer functions (default: hub torque → attitude)
+/// from the modes the run used, with the export's damping: a Bode plot (docs/export.md).
+fn bode_section(s: &Scenario, sim: &Simulation, o: &mut String) -> Result<(), OutputError> {
+    let e = &s.export;
+    if e.transfers.is_empty() {
+        return Ok(());
+    }
+    let Ok(ex) = crate::export::ExportModel::build(&sim.model, &sim.modes, e) else {
+        return Ok(());
+    };
+    let curves =
+        super::export::bode_curves(&ex, &e.transfers, e.frequency_range_hz, e.frequency_points);
+    let svg = super::plot::bode_svg("Frequency response", &curves)?;
+    let zetas: Vec<f64> = ex
+        .modes
+        .iter()
+        .filter(|m| !m.rigid)
+        .map(|m| m.damping_ratio)
+        .collect();
+    let zeta = match (
+        zetas.first(),
+        zetas.iter().all(|z| Some(z) == zetas.first()),
+    ) {
+        (Some(z), true) => format!("ζ = {z}"),
+        _ => "ζ per mode as [export] lists".to_string(),
+    };
+    let _ = writeln!(
+        o,
+        "<h3>Frequency response</h3><p class=\"note\">Transfer functions of the linear model \
+         (`flexcraft export`, docs/export.md) over the {} elastic modes above, modal damping {zeta}: \
+         magnitude (output unit per input unit) and phase.</p><figure class=\"bode\">{svg}</figure>",
+        zetas.len()
+    );
+    Ok(())
+}
+
 fn mode_shapes(sim: &Simulation, o: &mut String) -> Result<(), OutputError> {
     o.push_str("<h3>Mode shapes</h3><p class=\"note\">The first six elastic modes (rigid-body modes are not drawn): grey undeformed, blue deformed (exaggerated).</p><div class=\"modes\">\n");
     for m in sim.modes.elastic().take(6) {
@@ -904,7 +941,7 @@ pub fn report_html(
     );
     o.push_str(&scenario_section(s));
     o.push_str(&view_section(s, sim));
-    o.push_str(&modes_section(sim)?);
+    o.push_str(&modes_section(s, sim)?);
     o.push_str(&deployment_section(s, sim));
     o.push_str(&response_section(s, sim));
     let _ = write!(

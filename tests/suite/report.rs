@@ -91,6 +91,18 @@ fn report_has_every_section_nonempty_plots_and_the_summary_numbers() {
             serde_json::from_str(json_blocks(&html, "<div class=\"animation\"")[0]).unwrap();
         assert!(anim["frames"].as_array().unwrap().len() > 10);
         assert_eq!(html.matches("<figure class=\"shape\"").count(), 6);
+        // The Bode plot of the default transfer functions (hub torque → attitude about x, y,
+        // z for a free hub): one inline SVG, a magnitude and a phase trace per transfer.
+        if let Some(at) = html.find("<figure class=\"bode\">") {
+            let fig = &html[at..at + html[at..].find("</figure>").unwrap()];
+            assert!(fig.contains("hub.tz → hub.rz"), "{example}: Bode legend");
+            assert!(
+                fig.matches("<polyline").count() >= 6,
+                "{example}: Bode traces"
+            );
+        } else {
+            panic!("{example}: no Bode plot");
+        }
         // Table numbers equal summary.json's (data-key is a JSON pointer into it).
         let mut checked = 0;
         for (i, _) in html.match_indices("data-key=\"") {
