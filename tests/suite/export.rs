@@ -74,6 +74,19 @@ position = [0.5, 0.5, -0.3]
     )
 }
 
+/// Runs `flexcraft export examples/export.toml --out OUT` and checks it succeeded.
+fn export_example(out: &std::path::Path) {
+    use super::common::{bin, example};
+    let o = bin()
+        .arg("export")
+        .arg(example("export.toml"))
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 fn build(toml: &str) -> (RitzModel, ModalAnalysis, ExportModel, ExportSettings) {
     let s = scenario(toml);
     let model = RitzModel::assemble(&s.structure);
@@ -486,21 +499,10 @@ fn export_keys_are_refused_with_location() {
 /// The same input gives byte-identical files.
 #[test]
 fn export_is_byte_identical_between_runs() {
-    use super::common::{assert_same_tree, bin, example, scratch};
+    use super::common::{assert_same_tree, scratch};
     let dir = scratch("export_twice");
     for k in ["a", "b"] {
-        let out = bin()
-            .arg("export")
-            .arg(example("export.toml"))
-            .arg("--out")
-            .arg(dir.join(k))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        export_example(&dir.join(k));
     }
     assert!(assert_same_tree(&dir.join("a"), &dir.join("b")) >= 4);
 }
@@ -513,24 +515,13 @@ fn export_is_byte_identical_between_runs() {
 #[test]
 #[ignore = "needs Python with numpy and scipy: scripts/check_array_files.sh"]
 fn export_files_load_in_numpy_and_scipy() {
-    use super::common::{bin, example, scratch};
+    use super::common::scratch;
     let Some(python) = std::env::var_os("FLEXCRAFT_PYTHON") else {
         println!("FLEXCRAFT_PYTHON not set: skipped (run scripts/check_array_files.sh)");
         return;
     };
     let dir = scratch("export-python");
-    let out = bin()
-        .arg("export")
-        .arg(example("export.toml"))
-        .arg("--out")
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_example(&dir.join("out"));
     let script =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_export_files.py");
     let out = std::process::Command::new(&python)
@@ -556,21 +547,10 @@ fn export_files_load_in_numpy_and_scipy() {
 /// the hub and the named points where they are.
 #[test]
 fn flex_file_integrals_agree_with_the_ritz_participation() {
-    use super::common::{bin, example, scratch};
+    use super::common::scratch;
     use flexcraft::output::flex42::{read_flex_file, read_nodes_file};
     let dir = scratch("export-42");
-    let out = bin()
-        .arg("export")
-        .arg(example("export.toml"))
-        .arg("--out")
-        .arg(dir.join("out"))
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_example(&dir.join("out"));
     let text = std::fs::read_to_string(dir.join("out/flex_export.txt")).unwrap();
     let flex = read_flex_file(&text).expect("42 reads the flex file");
     let nodes =
@@ -713,8 +693,7 @@ fn fixed_hub_reaction_from_the_participation_equals_the_direct_one() {
         let dynk = Mat::from_fn(n, n, |i, j| kee[(i, j)] - omega * omega * mee[(i, j)]);
         let x = dynk.partial_piv_lu().solve(&mer);
         let direct = Mat::from_fn(6, 6, |i, j| {
-            mrr[(i, j)]
-                + omega * omega * (0..n).map(|k| mer[(k, i)] * x[(k, j)]).sum::<f64>()
+            mrr[(i, j)] + omega * omega * (0..n).map(|k| mer[(k, i)] * x[(k, j)]).sum::<f64>()
         });
         let scale = (0..6).map(|d| mrr[(d, d)]).fold(0.0, f64::max);
         for i in 0..6 {
