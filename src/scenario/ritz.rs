@@ -25,13 +25,13 @@ fn int_in(cx: &Ctx, v: &S<i64>, key: &str, lo: usize, hi: usize) -> Result<usize
 /// frequency error of every component) when any component is automatic or
 /// `[ritz] tolerance` is given; `None` otherwise (every count as written, no estimate).
 ///
-/// The wanted modes: `[ritz] modes`, else `[response] modes`, else
-/// [`refine::DEFAULT_MODES`]. `max_dof` must leave room for the components with given terms.
+/// The wanted modes: `[ritz] modes`, else the larger of `[response] modes` and `[export]
+/// modes` (`used_modes`), else [`refine::DEFAULT_MODES`]. `max_dof` must leave room for the components with given terms.
 pub(super) fn select(
     cx: &Ctx,
     raw: &RawScenario,
     structure: &Structure,
-    response_modes: Option<usize>,
+    used_modes: Option<usize>,
 ) -> Result<Option<TermSelection>, ScenarioError> {
     let automatic: Vec<ComponentId> = (raw.beams.iter().enumerate())
         .filter(|(_, b)| b.get_ref().terms.is_none())
@@ -54,7 +54,7 @@ pub(super) fn select(
     };
     let modes = match r.and_then(|r| r.modes.as_ref()) {
         Some(m) => int_in(cx, m, "ritz.modes", 1, L::MAX_RITZ_MODES)?,
-        None => response_modes.unwrap_or(d.modes).min(L::MAX_RITZ_MODES),
+        None => used_modes.unwrap_or(d.modes).min(L::MAX_RITZ_MODES),
     };
     let given: usize = crate::ritz::HUB_DOF
         + (structure.beams().iter().enumerate())
