@@ -244,7 +244,7 @@ class Modes(_Result):
         return f"Modes({len(self)} modes of {self.scenario.name!r})"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Latch:
     """One latching (plastic impact) of the deployment.
 
@@ -266,6 +266,16 @@ class Latch:
     energy_after: float
     energy_lost: float
     hinge_impulses: np.ndarray
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Latch):
+            return NotImplemented
+        return all(
+            np.array_equal(getattr(self, f), getattr(other, f))
+            for f in self.__dataclass_fields__
+        )
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 def _deploy_handle(scenario: Scenario, via: str):
@@ -369,7 +379,7 @@ class Simulation(_Result):
         return f"Simulation({self.scenario.name!r})"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SecondOrder:
     """The second-order modal form M η̈ + C η̇ + K η = B u, y = F η + G η̇ (M = I, the
     modes mass-normalised; C = diag(2ζω) [1/s], K = diag(ω²) [1/s²])."""

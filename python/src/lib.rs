@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 pyo3::create_exception!(
-    _flexcraft,
+    flexcraft,
     ScenarioError,
     PyValueError,
     "A scenario refused: `.file`, `.line`, `.column` (1-based; 0 when the file could not be \
@@ -36,14 +36,14 @@ pyo3::create_exception!(
      `file:line:column: key: reason`."
 );
 pyo3::create_exception!(
-    _flexcraft,
+    flexcraft,
     ComputationError,
     PyRuntimeError,
     "A numerical failure (a modal solve, the deployment's integration, a non-finite result), \
      with the command line's message."
 );
 pyo3::create_exception!(
-    _flexcraft,
+    flexcraft,
     InternalError,
     PyRuntimeError,
     "A bug in flexcraft (a Rust panic caught at the boundary); please report it with the \
