@@ -312,21 +312,21 @@ struct PyModes {
 
 /// A modal analysis of its own (`fc.modes`) or the one of a simulation.
 enum ModesSource {
-    Own(RitzModel, ModalAnalysis),
+    Own(Box<(RitzModel, ModalAnalysis)>),
     Simulation(Arc<Simulation>),
 }
 
 impl PyModes {
     fn model(&self) -> &RitzModel {
         match &self.src {
-            ModesSource::Own(m, _) => m,
+            ModesSource::Own(own) => &own.0,
             ModesSource::Simulation(s) => &s.model,
         }
     }
 
     fn modes(&self) -> &ModalAnalysis {
         match &self.src {
-            ModesSource::Own(_, m) => m,
+            ModesSource::Own(own) => &own.1,
             ModesSource::Simulation(s) => &s.modes,
         }
     }
@@ -353,7 +353,7 @@ fn non_finite(file: &str, r: Result<(), flexcraft::finite::NonFinite>) -> Result
 impl PyModes {
     /// The `modes --json` text (= modes.json).
     fn json(&self) -> String {
-        output::modes_json(&self.model(), self.modes())
+        output::modes_json(self.model(), self.modes())
     }
 
     /// Arrays: frequency_hz, omega, rigid, number, mass_matrix, stiffness_matrix,
@@ -433,17 +433,17 @@ impl PyModes {
                             "shape: ξ = {xi} is outside [0, 1]"
                         )));
                     }
-                    BeamStation::new(&self.model(), b, xi)
+                    BeamStation::new(self.model(), b, xi)
                         .ok_or_else(|| PyValueError::new_err("shape: no such beam"))
                 })
                 .collect::<PyResult<Vec<_>>>()?;
             m.iter()
                 .map(|mode| {
-                    let att = attachment_of(&self.model(), ComponentId::Beam(b), &mode.shape)
+                    let att = attachment_of(self.model(), ComponentId::Beam(b), &mode.shape)
                         .unwrap_or_default();
                     stations
                         .iter()
-                        .map(|s| six(s.sample(&self.model(), &mode.shape, att)))
+                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
                         .collect()
                 })
                 .collect()
@@ -469,16 +469,16 @@ impl PyModes {
                             "shape: (ξ, η) = ({xi}, {eta}) is outside [0, 1]²"
                         )));
                     }
-                    PlatePoint::new(&self.model(), p, xi, eta)
+                    PlatePoint::new(self.model(), p, xi, eta)
                         .ok_or_else(|| PyValueError::new_err("shape: no such plate"))
                 })
                 .collect::<PyResult<Vec<_>>>()?;
             m.iter()
                 .map(|mode| {
-                    let att = attachment_of(&self.model(), ComponentId::Plate(p), &mode.shape)
+                    let att = attachment_of(self.model(), ComponentId::Plate(p), &mode.shape)
                         .unwrap_or_default();
                     pts.iter()
-                        .map(|s| six(s.sample(&self.model(), &mode.shape, att)))
+                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
                         .collect()
                 })
                 .collect()
@@ -504,7 +504,7 @@ impl PyModes {
     #[pyo3(signature = (dir, force = false))]
     fn write(&self, py: Python<'_>, dir: PathBuf, force: bool) -> PyResult<usize> {
         write_dir(py, &dir, force, |o| {
-            output::write_modes(o, &self.model(), self.modes())
+            output::write_modes(o, self.model(), self.modes())
         })
     }
 }
@@ -558,7 +558,7 @@ fn modes(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyRe
             .with_selection(selection);
         non_finite(&file, flexcraft::finite::check_modes(&modes))?;
         Ok(PyModes {
-            src: ModesSource::Own(model, modes),
+            src: ModesSource::Own(Box::new((model, modes))),
         })
     })
 }
@@ -573,8 +573,10 @@ struct PyDeployment {
 /// A deployment of its own (`fc.deploy`) or the one of a simulation.
 enum DeploymentSource {
     Own(
-        flexcraft::deploy::coupled::Coupled,
-        flexcraft::deploy::DeploymentResult,
+        Box<(
+            flexcraft::deploy::coupled::Coupled,
+            flexcraft::deploy::DeploymentResult,
+        )>,
     ),
     Simulation(Arc<Simulation>),
 }
@@ -582,14 +584,14 @@ enum DeploymentSource {
 impl PyDeployment {
     fn coupled(&self) -> &flexcraft::deploy::coupled::Coupled {
         match &self.src {
-            DeploymentSource::Own(c, _) => c,
+            DeploymentSource::Own(own) => &own.0,
             DeploymentSource::Simulation(s) => &s.coupled,
         }
     }
 
     fn result(&self) -> &flexcraft::deploy::DeploymentResult {
         match &self.src {
-            DeploymentSource::Own(_, r) => r,
+            DeploymentSource::Own(own) => &own.1,
             DeploymentSource::Simulation(s) => &s.deployment,
         }
     }
@@ -679,7 +681,7 @@ fn deploy(
         non_finite(&file, flexcraft::finite::check_deployment(&result))?;
         Ok(PyDeployment {
             scenario: s,
-            src: DeploymentSource::Own(coupled, result),
+            src: DeploymentSource::Own(Box::new((coupled, result))),
         })
     })
 }
@@ -915,6 +917,22 @@ fn export(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyR
     })
 }
 
+/// The library alone: seconds spent in `deploy::simulate_coupled` for the scenario (the
+/// reference of python/bench.py's overhead figure; no conversion to Python objects).
+#[pyfunction]
+fn _library_deploy_seconds(py: Python<'_>, scenario: &PyScenario) -> PyResult<f64> {
+    let file = scenario.file.clone();
+    compute(py, || {
+        let d = scenario.deployment()?;
+        let t = std::time::Instant::now();
+        let r = flexcraft::deploy::simulate_coupled(&scenario.inner.structure, d)
+            .map_err(|e| Failure::Computation(format!("{file}: {e}")))?;
+        let s = t.elapsed().as_secs_f64();
+        drop(r);
+        Ok(s)
+    })
+}
+
 /// A panic raised on purpose, to test that it reaches Python as `InternalError`.
 #[pyfunction]
 fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
@@ -937,6 +955,7 @@ fn _flexcraft(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(export, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
+    m.add_function(wrap_pyfunction!(_library_deploy_seconds, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
