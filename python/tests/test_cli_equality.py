@@ -83,8 +83,9 @@ def test_deploy_equals_cli_json_and_csv(seed, seed_path, tmp_path):
     for i in range(d.alpha.shape[1]):
         assert same_bits(d.alpha[:, i], want[f"alpha_{i + 1} [rad]"])
         assert same_bits(d.rate[:, i], want[f"rate_{i + 1} [rad/s]"])
-    # The latches are the JSON's events.
-    events = d.to_dict()
+    # write() gives the command's folder.
+    d.write(tmp_path / "py")
+    assert_same_tree(out, tmp_path / "py")
     assert len(d.latches) >= 1
     assert d.latches[0].energy_lost == d.latches[0].energy_before - d.latches[0].energy_after
 
@@ -104,21 +105,36 @@ def test_simulate_equals_cli(seed_simulation, seed_path, seed_cli_out, tmp_path)
     assert s.modes.to_dict() == json.loads((seed_cli_out / "modes.json").read_text())
 
 
-def test_simulate_write_equals_cli_out(seed_simulation, seed_cli_out, tmp_path):
-    out = tmp_path / "py"
-    n = seed_simulation.write(out)
-    assert n > 0
-    cmp = filecmp.dircmp(seed_cli_out, out)
+def assert_same_tree(a, b):
+    """The same files in both folders, byte for byte."""
 
     def walk(c, rel=""):
         assert not c.left_only and not c.right_only, (rel, c.left_only, c.right_only)
-        # Shallow=False: byte comparison of every common file.
         _, mismatch, errors = filecmp.cmpfiles(c.left, c.right, c.common_files, shallow=False)
         assert not mismatch and not errors, (rel, mismatch, errors)
         for name, sub in c.subdirs.items():
             walk(sub, f"{rel}/{name}")
 
-    walk(cmp)
+    walk(filecmp.dircmp(a, b))
+
+
+def test_simulate_write_equals_cli_out(seed_simulation, seed_cli_out, tmp_path):
+    out = tmp_path / "py"
+    assert seed_simulation.write(out) > 0
+    assert_same_tree(seed_cli_out, out)
+
+
+@pytest.mark.parametrize("command", ["modes", "export"])
+def test_modes_and_export_write_equal_cli_out(command, tmp_path):
+    from conftest import run_cli
+
+    path = EXAMPLES / "export.toml"
+    cli = tmp_path / "cli"
+    p = run_cli(command, str(path), "--out", str(cli))
+    assert p.returncode == 0, p.stderr
+    result = getattr(fc, command)(fc.Scenario.from_file(path))
+    assert result.write(tmp_path / "py") > 0
+    assert_same_tree(cli, tmp_path / "py")
 
 
 def test_export_equals_cli_json():
