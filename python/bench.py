@@ -24,11 +24,13 @@ seed = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "examples" / "seed.toml"
 IMPORT_AND_MODES = f"""
 import time
 t0 = time.perf_counter()
+import numpy
+tn = time.perf_counter()
 import flexcraft as fc
 t1 = time.perf_counter()
 m = fc.modes(fc.Scenario.from_file({seed!r}))
 t2 = time.perf_counter()
-print(t1 - t0, t2 - t0)
+print(tn - t0, t1 - tn, t2 - t1)
 """
 
 runs = []
@@ -37,10 +39,13 @@ for _ in range(7):
         [sys.executable, "-c", IMPORT_AND_MODES], capture_output=True, text=True, check=True,
         cwd=ROOT / "target" if (ROOT / "target").is_dir() else None,
     ).stdout.split()
-    runs.append((float(out[0]), float(out[1])))
-imp = statistics.median(r[0] for r in runs)
-total = statistics.median(r[1] for r in runs)
-print(f"import flexcraft: {imp * 1e3:.1f} ms; import + from_file + fc.modes(seed): {total * 1e3:.1f} ms")
+    runs.append(tuple(float(v) for v in out))
+npy, imp, mod = (statistics.median(r[k] for r in runs) for k in range(3))
+print(
+    f"import numpy: {npy * 1e3:.1f} ms; then import flexcraft: {imp * 1e3:.1f} ms; "
+    f"from_file + fc.modes(seed): {mod * 1e3:.1f} ms; "
+    f"total {1e3 * (npy + imp + mod):.1f} ms, without NumPy's own import {1e3 * (imp + mod):.1f} ms"
+)
 
 import flexcraft as fc  # noqa: E402
 
