@@ -147,7 +147,6 @@ class _Result:
     def __getstate__(self):
         state = dict(self.__dict__)
         state.pop("_h", None)
-        state.pop("_columns", None)
         return state
 
     def __setstate__(self, state):

@@ -88,6 +88,11 @@ def test_pickling_round_trips(seed, seed_simulation):
         assert np.array_equal(sim.response[k], v)
     assert np.array_equal(sim.deployment.alpha, seed_simulation.deployment.alpha)
     assert sim.deployment.latches == seed_simulation.deployment.latches
+    # Columns pickled or not (computed on first access) read the same.
+    d = pickle.loads(pickle.dumps(seed_simulation.deployment))
+    cols = seed_simulation.deployment.columns
+    for k, v in d.columns.items():
+        assert np.array_equal(v, cols[k])
     x = fc.export(fc.Scenario.from_file(EXAMPLES / "export.toml"))
     x2 = pickle.loads(pickle.dumps(x))
     assert np.array_equal(x2.A, x.A) and x2.to_dict() == x.to_dict()
