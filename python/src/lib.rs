@@ -1,0 +1,961 @@
+//! `flexcraft._flexcraft`: the native half of the Python package. Each entry point does what
+//! the matching command of the `flexcraft` tool does (src/main.rs: `run_modes`, `run_deploy`,
+//! `run_simulate`, `run_export`) with the same library calls, and hands Python plain data:
+//! the command's `--json` text, NumPy arrays, and a handle on the Rust result for what needs
+//! it later (mode shapes at points, writing the output folder). The pure-Python package
+//! (`flexcraft/__init__.py`) wraps these in the documented classes.
+//!
+//! Every computation runs without the GIL and inside `catch_unwind`: a panic becomes
+//! `flexcraft.InternalError`, never an abort or a `PanicException`.
+
+use flexcraft::deploy::Deployment;
+use flexcraft::export::ExportModel;
+use flexcraft::faer::Mat;
+use flexcraft::output::{self, OutputDir};
+use flexcraft::ritz::shapes::{attachment_of, BeamStation, PlatePoint};
+use flexcraft::scenario::{ErrorKind, OverrideValue, ScenarioError as RustScenarioError};
+use flexcraft::simulation::Simulation;
+use flexcraft::structure::ComponentId;
+use flexcraft::{ModalAnalysis, RitzModel, Scenario};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+pyo3::create_exception!(
+    flexcraft,
+    ScenarioError,
+    PyValueError,
+    "A scenario refused: `.file`, `.line`, `.column` (1-based; 0 when the file could not be \
+     read or an override path did not resolve), `.key` (dotted path), `.reason`, `.kind` \
+     ('io', 'syntax', 'schema', 'invalid'); str() is the command line's message \
+     `file:line:column: key: reason`."
+);
+pyo3::create_exception!(
+    flexcraft,
+    ComputationError,
+    PyRuntimeError,
+    "A numerical failure (a modal solve, the deployment's integration, a non-finite result), \
+     with the command line's message."
+);
+pyo3::create_exception!(
+    flexcraft,
+    InternalError,
+    PyRuntimeError,
+    "A bug in flexcraft (a Rust panic caught at the boundary); please report it with the \
+     scenario."
+);
+
+/// The Python exception for a refused scenario, its fields as attributes.
+fn scenario_error(py: Python<'_>, e: &RustScenarioError) -> PyErr {
+    let err = ScenarioError::new_err(e.to_string());
+    let kind = match e.kind {
+        ErrorKind::Io => "io",
+        ErrorKind::Syntax => "syntax",
+        ErrorKind::Schema => "schema",
+        _ => "invalid",
+    };
+    let v = err.value(py);
+    let set = |k: &str, o: PyObject| v.setattr(k, o);
+    let ok = set(
+        "file",
+        e.file
+            .clone()
+            .into_pyobject(py)
+            .unwrap()
+            .into_any()
+            .unbind(),
+    )
+    .and(set(
+        "line",
+        e.location
+            .line
+            .into_pyobject(py)
+            .unwrap()
+            .into_any()
+            .unbind(),
+    ))
+    .and(set(
+        "column",
+        e.location
+            .column
+            .into_pyobject(py)
+            .unwrap()
+            .into_any()
+            .unbind(),
+    ))
+    .and(set(
+        "key",
+        e.key.clone().into_pyobject(py).unwrap().into_any().unbind(),
+    ))
+    .and(set(
+        "reason",
+        e.reason
+            .clone()
+            .into_pyobject(py)
+            .unwrap()
+            .into_any()
+            .unbind(),
+    ))
+    .and(set(
+        "kind",
+        kind.into_pyobject(py).unwrap().into_any().unbind(),
+    ));
+    match ok {
+        Ok(()) => err,
+        Err(e) => e,
+    }
+}
+
+/// Why a computation did not give a result.
+enum Failure {
+    Scenario(RustScenarioError),
+    Computation(String),
+    Panic(String),
+}
+
+impl Failure {
+    fn into_py(self, py: Python<'_>) -> PyErr {
+        match self {
+            Failure::Scenario(e) => scenario_error(py, &e),
+            Failure::Computation(m) => ComputationError::new_err(m),
+            Failure::Panic(m) => InternalError::new_err(format!(
+                "flexcraft panicked (a bug; please report it with the scenario): {m}"
+            )),
+        }
+    }
+}
+
+/// Runs `f` without the GIL, a panic turned into [`Failure::Panic`].
+fn compute<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, Failure> + Send) -> PyResult<T> {
+    let r = py.allow_threads(|| {
+        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| {
+            let msg = p
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| p.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "(no message)".into());
+            Err(Failure::Panic(msg))
+        })
+    });
+    r.map_err(|e| e.into_py(py))
+}
+
+/// Half of the machine's memory, the command line's default budget (src/main.rs).
+fn default_memory_budget() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|m| {
+            m.lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or(8 << 30, |kb| kb * 1024 / 2)
+}
+
+/// A validated scenario (the library's `Scenario`) and the name it was read under.
+#[pyclass(module = "flexcraft._flexcraft", frozen, name = "_Scenario")]
+struct PyScenario {
+    inner: Arc<Scenario>,
+    /// The file as named by the caller (errors and the report's footer), or the name given
+    /// to `from_toml`.
+    file: String,
+}
+
+impl PyScenario {
+    /// `file`'s last component, as the command line names the scenario in the report.
+    fn file_name(&self) -> String {
+        Path::new(&self.file)
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    }
+
+    /// The command line's memory check (default budget), then the scenario.
+    fn checked(&self, max_memory: Option<u64>) -> Result<Arc<Scenario>, Failure> {
+        self.inner
+            .check_budget(max_memory.unwrap_or_else(default_memory_budget))
+            .map_err(Failure::Scenario)?;
+        Ok(self.inner.clone())
+    }
+
+    fn deployment(&self) -> Result<&Deployment, Failure> {
+        self.inner.deployment.as_ref().ok_or_else(|| {
+            Failure::Scenario(RustScenarioError {
+                kind: ErrorKind::Invalid,
+                file: self.file.clone(),
+                location: Default::default(),
+                key: "deployment".into(),
+                reason: "the scenario has no [deployment] section (see docs/scenario.md)".into(),
+            })
+        })
+    }
+}
+
+#[pymethods]
+impl PyScenario {
+    #[staticmethod]
+    fn from_file(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let file = path.display().to_string();
+        let inner = compute(py, || Scenario::from_file(&path).map_err(Failure::Scenario))?;
+        Ok(Self {
+            inner: Arc::new(inner),
+            file,
+        })
+    }
+
+    #[staticmethod]
+    #[pyo3(signature = (text, file = "<string>".to_string()))]
+    fn from_toml(py: Python<'_>, text: String, file: String) -> PyResult<Self> {
+        let inner = compute(py, || {
+            Scenario::from_toml_str(&text, &file).map_err(Failure::Scenario)
+        })?;
+        Ok(Self {
+            inner: Arc::new(inner),
+            file,
+        })
+    }
+
+    /// Values replaced at dotted paths, validated like a file.
+    fn with_values(&self, py: Python<'_>, values: &Bound<'_, PyDict>) -> PyResult<Self> {
+        let mut owned: Vec<(String, OverrideValue)> = Vec::new();
+        for (k, v) in values.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| PyTypeError::new_err("with_values: keys are dotted paths (str)"))?;
+            let value = if v.is_instance_of::<PyBool>() {
+                OverrideValue::Bool(v.extract()?)
+            } else if v.is_instance_of::<PyInt>() || v.is_instance_of::<PyFloat>() {
+                OverrideValue::Number(v.extract()?)
+            } else if v.is_instance_of::<PyString>() {
+                OverrideValue::Text(v.extract()?)
+            } else if let Ok(x) = v.extract::<f64>() {
+                // NumPy scalars and anything else with __float__.
+                OverrideValue::Number(x)
+            } else {
+                return Err(PyTypeError::new_err(format!(
+                    "with_values: {key}: a value is a number, a string or a bool, not {}",
+                    v.get_type().name()?
+                )));
+            };
+            owned.push((key, value));
+        }
+        let inner = self.inner.clone();
+        let s = compute(py, move || {
+            let pairs: Vec<(&str, OverrideValue)> =
+                owned.iter().map(|(k, v)| (k.as_str(), v.clone())).collect();
+            inner.with_values(&pairs).map_err(Failure::Scenario)
+        })?;
+        Ok(Self {
+            inner: Arc::new(s),
+            file: self.file.clone(),
+        })
+    }
+
+    #[getter]
+    fn toml(&self) -> &str {
+        self.inner.source_text()
+    }
+
+    #[getter]
+    fn name(&self) -> &str {
+        &self.inner.name
+    }
+
+    #[getter]
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    #[getter]
+    fn has_deployment(&self) -> bool {
+        self.inner.deployment.is_some()
+    }
+
+    /// Component names: (beams, plates, masses).
+    fn components(&self) -> (Vec<String>, Vec<String>, Vec<String>) {
+        let st = &self.inner.structure;
+        (
+            st.beams().iter().map(|b| b.name().to_string()).collect(),
+            st.plates().iter().map(|p| p.name().to_string()).collect(),
+            st.masses().iter().map(|m| m.name().to_string()).collect(),
+        )
+    }
+}
+
+/// A column-major faer matrix as a NumPy array.
+fn mat<'py>(py: Python<'py>, m: &Mat<f64>) -> Bound<'py, PyAny> {
+    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)])
+        .into_pyarray(py)
+        .into_any()
+}
+
+fn rows<'py, const N: usize>(py: Python<'py>, r: &[[f64; N]]) -> Bound<'py, PyAny> {
+    Array2::from_shape_fn((r.len(), N), |(i, j)| r[i][j])
+        .into_pyarray(py)
+        .into_any()
+}
+
+fn vec1<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
+    v.into_pyarray(py).into_any()
+}
+
+/// The model and modes of `fc.modes`, kept for mode shapes at points and for writing.
+#[pyclass(module = "flexcraft._flexcraft", frozen, name = "_Modes")]
+struct PyModes {
+    src: ModesSource,
+}
+
+/// A modal analysis of its own (`fc.modes`) or the one of a simulation.
+enum ModesSource {
+    Own(Box<(RitzModel, ModalAnalysis)>),
+    Simulation(Arc<Simulation>),
+}
+
+impl PyModes {
+    fn model(&self) -> &RitzModel {
+        match &self.src {
+            ModesSource::Own(own) => &own.0,
+            ModesSource::Simulation(s) => &s.model,
+        }
+    }
+
+    fn modes(&self) -> &ModalAnalysis {
+        match &self.src {
+            ModesSource::Own(own) => &own.1,
+            ModesSource::Simulation(s) => &s.modes,
+        }
+    }
+}
+
+/// The command line's `numerical_failure` message.
+fn ritz_failure(s: &Scenario, model: &RitzModel, e: &flexcraft::ritz::RitzError) -> Failure {
+    let id = model.culprit(e);
+    let name = s.structure.component_name(id);
+    Failure::Scenario(s.locate(
+        id,
+        format!(
+            "{e}; traced to component \"{name}\": check its values against the others \
+             (masses, stiffnesses and sizes that differ by many orders of magnitude)"
+        ),
+    ))
+}
+
+fn non_finite(file: &str, r: Result<(), flexcraft::finite::NonFinite>) -> Result<(), Failure> {
+    r.map_err(|e| Failure::Computation(format!("{file}: {e}")))
+}
+
+#[pymethods]
+impl PyModes {
+    /// The `modes --json` text (= modes.json).
+    fn json(&self) -> String {
+        output::modes_json(self.model(), self.modes())
+    }
+
+    /// Arrays: frequency_hz, omega, rigid, number, mass_matrix, stiffness_matrix,
+    /// coefficients (modes × coordinates), effective_mass (hub-fixed modes × 6),
+    /// participation (hub-fixed modes × 6), hub_fixed_omega.
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let m = &self.modes().modes;
+        d.set_item("omega", vec1(py, m.iter().map(|m| m.omega_rad_s).collect()))?;
+        d.set_item(
+            "frequency_hz",
+            vec1(py, m.iter().map(|m| m.frequency_hz()).collect()),
+        )?;
+        d.set_item(
+            "rigid",
+            m.iter()
+                .map(|m| m.rigid)
+                .collect::<Vec<bool>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item(
+            "number",
+            m.iter()
+                .map(|m| m.number as i64)
+                .collect::<Vec<i64>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item("mass_matrix", mat(py, &self.model().mass))?;
+        d.set_item("stiffness_matrix", mat(py, &self.model().stiffness))?;
+        let dof = self.model().dof();
+        d.set_item(
+            "coefficients",
+            Array2::from_shape_fn((m.len(), dof), |(i, j)| m[i].shape[j]).into_pyarray(py),
+        )?;
+        let hf = &self.modes().hub_fixed;
+        let em: Vec<[f64; 6]> = hf.iter().map(|h| h.effective_mass).collect();
+        let pa: Vec<[f64; 6]> = hf.iter().map(|h| h.participation).collect();
+        d.set_item("effective_mass", rows(py, &em))?;
+        d.set_item("participation", rows(py, &pa))?;
+        d.set_item(
+            "hub_fixed_omega",
+            vec1(py, hf.iter().map(|h| h.omega_rad_s).collect()),
+        )?;
+        d.set_item(
+            "appendage_mass",
+            vec1(py, self.modes().appendage_mass.to_vec()),
+        )?;
+        Ok(d)
+    }
+
+    /// Displacement and small rotation [ux, uy, uz, rx, ry, rz] (structure frame, m and rad
+    /// per unit modal coordinate) of `component` at `points` for every mode: a beam's points
+    /// are ξ = x/L (1-D), a plate's (ξ, η) pairs (n × 2), both in [0, 1]. Returns
+    /// modes × points × 6 as a flat vector and its shape.
+    fn shape<'py>(
+        &self,
+        py: Python<'py>,
+        component: &str,
+        points: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let st = &self.model().structure;
+        let m = &self.modes().modes;
+        let beam = st.beams().iter().position(|b| b.name() == component);
+        let plate = st.plates().iter().position(|p| p.name() == component);
+        let samples: Vec<Vec<[f64; 6]>> = if let Some(b) = beam {
+            let xs: PyReadonlyArray1<f64> = points.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "shape: \"{component}\" is a beam: points is a 1-D float array of ξ = x/L"
+                ))
+            })?;
+            let xs = xs.as_slice()?.to_vec();
+            let stations = xs
+                .iter()
+                .map(|&xi| {
+                    if !(0.0..=1.0).contains(&xi) {
+                        return Err(PyValueError::new_err(format!(
+                            "shape: ξ = {xi} is outside [0, 1]"
+                        )));
+                    }
+                    BeamStation::new(self.model(), b, xi)
+                        .ok_or_else(|| PyValueError::new_err("shape: no such beam"))
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            m.iter()
+                .map(|mode| {
+                    let att = attachment_of(self.model(), ComponentId::Beam(b), &mode.shape)
+                        .unwrap_or_default();
+                    stations
+                        .iter()
+                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
+                        .collect()
+                })
+                .collect()
+        } else if let Some(p) = plate {
+            let xy: PyReadonlyArray2<f64> = points.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "shape: \"{component}\" is a plate: points is an n × 2 float array of (ξ, η)"
+                ))
+            })?;
+            let xy = xy.as_array();
+            if xy.ncols() != 2 {
+                return Err(PyValueError::new_err(
+                    "shape: a plate's points are n × 2 (ξ, η)",
+                ));
+            }
+            let pts = xy
+                .rows()
+                .into_iter()
+                .map(|r| {
+                    let (xi, eta) = (r[0], r[1]);
+                    if !(0.0..=1.0).contains(&xi) || !(0.0..=1.0).contains(&eta) {
+                        return Err(PyValueError::new_err(format!(
+                            "shape: (ξ, η) = ({xi}, {eta}) is outside [0, 1]²"
+                        )));
+                    }
+                    PlatePoint::new(self.model(), p, xi, eta)
+                        .ok_or_else(|| PyValueError::new_err("shape: no such plate"))
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            m.iter()
+                .map(|mode| {
+                    let att = attachment_of(self.model(), ComponentId::Plate(p), &mode.shape)
+                        .unwrap_or_default();
+                    pts.iter()
+                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
+                        .collect()
+                })
+                .collect()
+        } else {
+            let names: Vec<&str> = st
+                .beams()
+                .iter()
+                .map(|b| b.name())
+                .chain(st.plates().iter().map(|p| p.name()))
+                .collect();
+            return Err(PyValueError::new_err(format!(
+                "shape: no beam or plate is named {component:?} (the model has {names:?})"
+            )));
+        };
+        let n = samples.first().map_or(0, Vec::len);
+        let flat: Vec<f64> = samples.iter().flatten().flatten().copied().collect();
+        let a = numpy::ndarray::Array3::from_shape_vec((m.len(), n, 6), flat)
+            .map_err(|e| InternalError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py).into_any())
+    }
+
+    /// Writes what `flexcraft modes --out DIR` writes.
+    #[pyo3(signature = (dir, force = false))]
+    fn write(&self, py: Python<'_>, dir: PathBuf, force: bool) -> PyResult<usize> {
+        write_dir(py, &dir, force, |o| {
+            output::write_modes(o, self.model(), self.modes())
+        })
+    }
+}
+
+fn six(p: flexcraft::ritz::shapes::PointSample) -> [f64; 6] {
+    let (d, r) = (p.displacement, p.rotation);
+    [d.0[0], d.0[1], d.0[2], r.0[0], r.0[1], r.0[2]]
+}
+
+/// Stages, writes and swaps in an output folder as the command line does.
+fn write_dir(
+    py: Python<'_>,
+    dir: &Path,
+    force: bool,
+    write: impl FnOnce(&mut OutputDir) -> Result<(), output::OutputError> + Send,
+) -> PyResult<usize> {
+    compute(py, || {
+        let mut o = OutputDir::create(dir, force).map_err(|e| {
+            if e.is_refusal() {
+                Failure::Computation(format!("{e}"))
+            } else {
+                Failure::Computation(format!("writing {}: {e}", dir.display()))
+            }
+        })?;
+        write(&mut o)
+            .and_then(|()| o.commit())
+            .map_err(|e| Failure::Computation(format!("writing {}: {e}", dir.display())))
+    })
+    .map_err(|e| {
+        Python::with_gil(|py| {
+            if e.is_instance_of::<ComputationError>(py) {
+                PyErr::new::<pyo3::exceptions::PyOSError, _>(e.value(py).to_string())
+            } else {
+                e
+            }
+        })
+    })
+}
+
+/// `flexcraft modes`: the lowest modes an automatic term selection aims at, or all.
+#[pyfunction]
+#[pyo3(signature = (scenario, max_memory = None))]
+fn modes(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyResult<PyModes> {
+    let file = scenario.file.clone();
+    compute(py, || {
+        let s = scenario.checked(max_memory)?;
+        let model = RitzModel::assemble(&s.structure);
+        let selection = s.term_selection.as_ref();
+        let modes = ModalAnalysis::compute_lowest(&model, selection.map(|s| s.accuracy.modes))
+            .map_err(|e| ritz_failure(&s, &model, &e))?
+            .with_selection(selection);
+        non_finite(&file, flexcraft::finite::check_modes(&modes))?;
+        Ok(PyModes {
+            src: ModesSource::Own(Box::new((model, modes))),
+        })
+    })
+}
+
+/// The deployment of `fc.deploy` (and of `fc.simulate`).
+#[pyclass(module = "flexcraft._flexcraft", frozen, name = "_Deployment")]
+struct PyDeployment {
+    scenario: Arc<Scenario>,
+    src: DeploymentSource,
+}
+
+/// A deployment of its own (`fc.deploy`) or the one of a simulation.
+enum DeploymentSource {
+    Own(
+        Box<(
+            flexcraft::deploy::coupled::Coupled,
+            flexcraft::deploy::DeploymentResult,
+        )>,
+    ),
+    Simulation(Arc<Simulation>),
+}
+
+impl PyDeployment {
+    fn coupled(&self) -> &flexcraft::deploy::coupled::Coupled {
+        match &self.src {
+            DeploymentSource::Own(own) => &own.0,
+            DeploymentSource::Simulation(s) => &s.coupled,
+        }
+    }
+
+    fn result(&self) -> &flexcraft::deploy::DeploymentResult {
+        match &self.src {
+            DeploymentSource::Own(own) => &own.1,
+            DeploymentSource::Simulation(s) => &s.deployment,
+        }
+    }
+
+    fn d(&self) -> &Deployment {
+        self.scenario
+            .deployment
+            .as_ref()
+            .expect("a deployment result is made for a scenario with [deployment]")
+    }
+}
+
+#[pymethods]
+impl PyDeployment {
+    /// The `deploy --json` text (= events.json).
+    fn json(&self) -> String {
+        output::deploy_json(&self.scenario.name, self.d(), self.coupled(), self.result())
+    }
+
+    /// deployment.csv's text.
+    fn csv(&self) -> String {
+        output::deployment_csv(self.coupled(), self.result())
+    }
+
+    /// Arrays: t (samples), alpha and rate (samples × hinges), and the latches as dicts.
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let s = &self.result().samples;
+        let n = self.coupled().panels();
+        d.set_item("t", vec1(py, s.iter().map(|s| s.t).collect()))?;
+        let grid = |f: &dyn Fn(&flexcraft::deploy::Sample, usize) -> f64| {
+            Array2::from_shape_fn((s.len(), n), |(k, i)| f(&s[k], i))
+        };
+        d.set_item("alpha", grid(&|s, i| s.alpha[i]).into_pyarray(py))?;
+        d.set_item("rate", grid(&|s, i| s.rate[i]).into_pyarray(py))?;
+        let latches = PyList::empty(py);
+        for e in &self.result().latches {
+            let l = PyDict::new(py);
+            l.set_item("time", e.time)?;
+            l.set_item("hinge", e.hinge)?;
+            l.set_item("locked", e.locked.clone())?;
+            l.set_item("angles", vec1(py, e.angles.clone()))?;
+            l.set_item("rates_before", vec1(py, e.rates_before.clone()))?;
+            l.set_item("rates_after", vec1(py, e.rates_after.clone()))?;
+            l.set_item("energy_before", e.energy_before)?;
+            l.set_item("energy_after", e.energy_after)?;
+            l.set_item("energy_lost", e.energy_before - e.energy_after)?;
+            let imp: Vec<[f64; 3]> = e.impulses.iter().map(|(p, m)| [p[0], p[1], *m]).collect();
+            l.set_item("hinge_impulses", rows(py, &imp))?;
+            latches.append(l)?;
+        }
+        d.set_item("latches", latches)?;
+        d.set_item("all_latched", self.result().all_latched)?;
+        d.set_item("final_time", self.result().final_time)?;
+        Ok(d)
+    }
+
+    /// Writes what `flexcraft deploy --out DIR` writes.
+    #[pyo3(signature = (dir, force = false))]
+    fn write(&self, py: Python<'_>, dir: PathBuf, force: bool) -> PyResult<usize> {
+        write_dir(py, &dir, force, |o| {
+            output::write_deploy(
+                o,
+                &self.scenario.name,
+                self.d(),
+                self.coupled(),
+                self.result(),
+            )
+        })
+    }
+}
+
+/// `flexcraft deploy`: the coupled deployment of `[deployment]`.
+#[pyfunction]
+#[pyo3(signature = (scenario, max_memory = None))]
+fn deploy(
+    py: Python<'_>,
+    scenario: &PyScenario,
+    max_memory: Option<u64>,
+) -> PyResult<PyDeployment> {
+    let file = scenario.file.clone();
+    compute(py, || {
+        let s = scenario.checked(max_memory)?;
+        let d = scenario.deployment()?;
+        let (coupled, result) = flexcraft::deploy::simulate_coupled(&s.structure, d)
+            .map_err(|e| Failure::Computation(format!("{file}: {e}")))?;
+        non_finite(&file, flexcraft::finite::check_deployment(&result))?;
+        Ok(PyDeployment {
+            scenario: s,
+            src: DeploymentSource::Own(Box::new((coupled, result))),
+        })
+    })
+}
+
+/// The whole story of `fc.simulate`.
+#[pyclass(module = "flexcraft._flexcraft", frozen, name = "_Simulation")]
+struct PySimulation {
+    scenario: Arc<Scenario>,
+    file_name: String,
+    sim: Arc<Simulation>,
+}
+
+#[pymethods]
+impl PySimulation {
+    /// The `simulate --json` text (= summary.json).
+    fn json(&self) -> String {
+        output::simulate_json(&self.scenario, &self.sim)
+    }
+
+    /// response.csv as (header names, samples × columns array); None without a response.
+    fn response<'py>(&self, py: Python<'py>) -> Option<(Vec<String>, Bound<'py, PyAny>)> {
+        let r = self.sim.response.as_ref()?;
+        let hist = &r.history;
+        // The columns of write_simulate's response.csv, in its order.
+        let mut header = vec!["t [s]".to_string(), "t_after_latch [s]".to_string()];
+        header.extend(
+            r.channels
+                .iter()
+                .map(|ch| format!("{} [{}]", ch.name, ch.unit)),
+        );
+        header.extend(
+            r.modal
+                .modes
+                .iter()
+                .map(|m| format!("eta_{} [√kg·m]", m.number)),
+        );
+        let (nc, nm) = (r.channels.len(), r.modal.modes.len());
+        let t_latch = r.handover.latch_time;
+        let a = Array2::from_shape_fn((hist.times.len(), 2 + nc + nm), |(k, j)| match j {
+            0 => t_latch + hist.times[k],
+            1 => hist.times[k],
+            j if j < 2 + nc => hist.values[(k, j - 2)],
+            j => hist.modal[(k, j - 2 - nc)],
+        });
+        Some((header, a.into_pyarray(py).into_any()))
+    }
+
+    /// The modes and the deployment of the run, as the handles of `fc.modes` and `fc.deploy`.
+    fn parts(&self) -> (PyModes, PyDeployment) {
+        (
+            PyModes {
+                src: ModesSource::Simulation(self.sim.clone()),
+            },
+            PyDeployment {
+                scenario: self.scenario.clone(),
+                src: DeploymentSource::Simulation(self.sim.clone()),
+            },
+        )
+    }
+
+    /// Writes what `flexcraft simulate --out DIR` writes.
+    #[pyo3(signature = (dir, force = false))]
+    fn write(&self, py: Python<'_>, dir: PathBuf, force: bool) -> PyResult<usize> {
+        let source = self.scenario.source_text().as_bytes().to_vec();
+        write_dir(py, &dir, force, |o| {
+            output::write_simulate(o, &self.scenario, &self.sim, &source, &self.file_name)
+        })
+    }
+}
+
+/// `flexcraft simulate`: modes, deployment, hand-over and response.
+#[pyfunction]
+#[pyo3(signature = (scenario, max_memory = None))]
+fn simulate(
+    py: Python<'_>,
+    scenario: &PyScenario,
+    max_memory: Option<u64>,
+) -> PyResult<PySimulation> {
+    let file = scenario.file.clone();
+    let file_name = scenario.file_name();
+    compute(py, || {
+        let s = scenario.checked(max_memory)?;
+        scenario.deployment()?;
+        let sim = Simulation::run(&s).map_err(|e| match &e {
+            flexcraft::simulation::SimulationError::Ritz(r) => {
+                ritz_failure(&s, &RitzModel::assemble(&s.structure), r)
+            }
+            _ => Failure::Computation(format!("{file}: {e}")),
+        })?;
+        non_finite(&file, flexcraft::finite::check_simulation(&sim))?;
+        Ok(PySimulation {
+            scenario: s,
+            file_name,
+            sim: Arc::new(sim),
+        })
+    })
+}
+
+/// The linear model of `fc.export`.
+#[pyclass(module = "flexcraft._flexcraft", frozen, name = "_Export")]
+struct PyExport {
+    scenario: Arc<Scenario>,
+    body: String,
+    model: RitzModel,
+    modes: ModalAnalysis,
+    ex: ExportModel,
+    warnings: Vec<String>,
+}
+
+#[pymethods]
+impl PyExport {
+    /// The `export --json` text (= model.json).
+    fn json(&self) -> String {
+        let st = &self.scenario.structure;
+        output::export_json(st, &self.modes, &self.ex, &self.scenario.export.transfers)
+    }
+
+    /// The command's warnings (e.g. fewer modes than asked for).
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    /// Arrays and names of the first- and second-order forms and the modal data.
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        let ex = &self.ex;
+        let ss = ex.first_order();
+        d.set_item("A", mat(py, &ss.a))?;
+        d.set_item("B", mat(py, &ss.b))?;
+        d.set_item("C", mat(py, &ss.c))?;
+        d.set_item("D", mat(py, &ss.d))?;
+        d.set_item("state_names", ss.state_names)?;
+        d.set_item("input_names", ex.input_names.clone())?;
+        d.set_item("output_names", ex.output_names.clone())?;
+        let n = ex.mode_count();
+        d.set_item("M2", mat(py, &Mat::<f64>::identity(n, n)))?;
+        d.set_item("C2", mat(py, &ex.damping()))?;
+        d.set_item("K2", mat(py, &ex.stiffness()))?;
+        d.set_item("B2", mat(py, &ex.b))?;
+        d.set_item("F", mat(py, &ex.f))?;
+        d.set_item("G", mat(py, &ex.g))?;
+        d.set_item(
+            "omega",
+            vec1(py, ex.modes.iter().map(|m| m.omega_rad_s).collect()),
+        )?;
+        d.set_item(
+            "damping_ratio",
+            vec1(py, ex.modes.iter().map(|m| m.damping_ratio).collect()),
+        )?;
+        d.set_item(
+            "rigid",
+            ex.modes
+                .iter()
+                .map(|m| m.rigid)
+                .collect::<Vec<bool>>()
+                .into_pyarray(py),
+        )?;
+        d.set_item("site_shapes", mat(py, &ex.site_shapes))?;
+        let sites: Vec<[f64; 3]> = ex.site_positions.iter().map(|p| p.0).collect();
+        d.set_item("site_positions", rows(py, &sites))?;
+        d.set_item("total_mass", ex.total_mass)?;
+        let c = ex.center_of_mass;
+        d.set_item("center_of_mass", vec1(py, c.0.to_vec()))?;
+        d.set_item("rigid_mass_reference", rows(py, &ex.rigid_mass_reference))?;
+        d.set_item("rigid_mass_cm", rows(py, &ex.rigid_mass_cm))?;
+        d.set_item("hub_fixed_omega", vec1(py, ex.hub_fixed_omega.clone()))?;
+        d.set_item("participation", mat(py, &ex.participation))?;
+        d.set_item("effective_mass", mat(py, &ex.effective_mass))?;
+        d.set_item(
+            "effective_mass_fraction",
+            mat(py, &ex.effective_mass_fraction),
+        )?;
+        d.set_item("appendage_mass", vec1(py, ex.appendage_mass.to_vec()))?;
+        Ok(d)
+    }
+
+    /// Writes what `flexcraft export --out DIR` writes.
+    #[pyo3(signature = (dir, force = false))]
+    fn write(&self, py: Python<'_>, dir: PathBuf, force: bool) -> PyResult<usize> {
+        let settings = &self.scenario.export;
+        write_dir(py, &dir, force, |d| {
+            output::write_export(
+                d,
+                &self.model,
+                &self.body,
+                &self.modes,
+                &self.ex,
+                &settings.transfers,
+                settings.frequency_range_hz,
+                settings.frequency_points,
+            )
+        })
+    }
+}
+
+/// `flexcraft export`: the linear model for control design.
+#[pyfunction]
+#[pyo3(signature = (scenario, max_memory = None))]
+fn export(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyResult<PyExport> {
+    let file = scenario.file.clone();
+    let body = output::flex_body_name(
+        &Path::new(&file)
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned()),
+    );
+    compute(py, || {
+        let s = scenario.checked(max_memory)?;
+        let model = RitzModel::assemble(&s.structure);
+        let wanted = s.export_modes();
+        let selection = s.term_selection.as_ref();
+        let modes = ModalAnalysis::compute_lowest(&model, wanted)
+            .map_err(|e| ritz_failure(&s, &model, &e))?
+            .with_selection(selection);
+        non_finite(&file, flexcraft::finite::check_modes(&modes))?;
+        let available = modes.elastic().count();
+        let mut warnings = Vec::new();
+        if let Some(w) = wanted.filter(|w| *w > available) {
+            warnings.push(format!(
+                "{file}: export.modes: {w} elastic modes asked for, the model has {available}; \
+                 all {available} are kept"
+            ));
+        }
+        let ex = ExportModel::build(&model, &modes, &s.export)
+            .map_err(|e| Failure::Scenario(s.refuse_export_damping(e.to_string())))?;
+        Ok(PyExport {
+            scenario: s,
+            body,
+            model,
+            modes,
+            ex,
+            warnings,
+        })
+    })
+}
+
+/// The library alone: seconds spent in `deploy::simulate_coupled` for the scenario (the
+/// reference of python/bench.py's overhead figure; no conversion to Python objects).
+#[pyfunction]
+fn _library_deploy_seconds(py: Python<'_>, scenario: &PyScenario) -> PyResult<f64> {
+    let file = scenario.file.clone();
+    compute(py, || {
+        let d = scenario.deployment()?;
+        let t = std::time::Instant::now();
+        let r = flexcraft::deploy::simulate_coupled(&scenario.inner.structure, d)
+            .map_err(|e| Failure::Computation(format!("{file}: {e}")))?;
+        let s = t.elapsed().as_secs_f64();
+        drop(r);
+        Ok(s)
+    })
+}
+
+/// A panic raised on purpose, to test that it reaches Python as `InternalError`.
+#[pyfunction]
+fn _panic_for_test(py: Python<'_>) -> PyResult<()> {
+    compute(py, || -> Result<(), Failure> { panic!("test panic") })
+}
+
+#[pymodule]
+fn _flexcraft(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("ScenarioError", py.get_type::<ScenarioError>())?;
+    m.add("ComputationError", py.get_type::<ComputationError>())?;
+    m.add("InternalError", py.get_type::<InternalError>())?;
+    m.add_class::<PyScenario>()?;
+    m.add_class::<PyModes>()?;
+    m.add_class::<PyDeployment>()?;
+    m.add_class::<PySimulation>()?;
+    m.add_class::<PyExport>()?;
+    m.add_function(wrap_pyfunction!(modes, m)?)?;
+    m.add_function(wrap_pyfunction!(deploy, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(export, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
+    m.add_function(wrap_pyfunction!(_library_deploy_seconds, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
