@@ -181,6 +181,78 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
     s
 }
 
+/// Text for HTML.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A number for the report (4 significant digits; "–" for a missing one).
+fn sig(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.4e}")
+    } else if v.is_nan() {
+        "–".into()
+    } else {
+        format!("{v}")
+    }
+}
+
+/// report.html: the Monte Carlo section — verdicts, statistics, sensitivity, plots (linked
+/// from plots/).
+pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
+    let mut h = String::from(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Monte Carlo</title>\n\
+         <style>body{font-family:sans-serif;max-width:70em;margin:2em auto}td,th{padding:2px 8px;text-align:right}\
+         td:first-child,th:first-child{text-align:left}.met{color:#070}.not{color:#b00}</style></head><body>\n",
+    );
+    h += &format!(
+        "<h1>Monte Carlo dispersions</h1>\n<p>{} runs, seed {}; fingerprint <code>{}</code>.</p>\n",
+        info.runs, info.seed, info.hash
+    );
+    h += "<h2>Requirements (order statistics)</h2>\n<table><tr><th>requirement</th><th>output</th><th>bound</th><th>p / c</th><th>failures</th><th>allowed</th><th>runs needed</th><th>tolerance bound</th><th>verdict</th><th>strongest driver</th></tr>\n";
+    for v in &a.verdicts {
+        let q = &v.requirement;
+        let bound = match (q.min, q.max) {
+            (Some(lo), Some(hi)) => format!("{lo} … {hi}"),
+            (Some(lo), None) => format!("≥ {lo}"),
+            (None, Some(hi)) => format!("≤ {hi}"),
+            (None, None) => String::new(),
+        };
+        let driver = v
+            .drivers
+            .first()
+            .filter(|d| d.1.is_finite())
+            .map_or(String::new(), |(p, r)| format!("{} (ρ = {r:.3})", esc(p)));
+        h += &format!(
+            "<tr><td>{}</td><td>{}</td><td>{bound}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{}\">{}</td><td>{driver}</td></tr>\n",
+            esc(&q.name), esc(&q.output), q.probability, q.confidence, v.failures,
+            v.allowed.map_or("none".into(), |f| f.to_string()), v.runs_needed,
+            v.tolerance_bound.map_or("–".into(), sig),
+            if v.met { "met" } else { "not" }, if v.met { "met" } else { "not met" },
+        );
+    }
+    h += "</table>\n<h2>Outputs</h2>\n<table><tr><th>output</th><th>mean</th><th>sd</th><th>min</th><th>p50</th><th>p99</th><th>max</th><th>strongest parameter</th></tr>\n";
+    for ((n, o), (_, rank)) in a.outputs.iter().zip(&a.sensitivity) {
+        let top = rank
+            .first()
+            .filter(|d| d.1.is_finite())
+            .map_or(String::new(), |(p, r)| format!("{} ({r:.3})", esc(p)));
+        h += &format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{top}</td></tr>\n",
+            esc(n), sig(o.mean), sig(o.sd), sig(o.min), sig(o.percentiles[3]), sig(o.percentiles[6]), sig(o.max)
+        );
+    }
+    h += "</table>\n<h2>Plots</h2>\n";
+    for p in plots {
+        h += &format!("<p><img src=\"plots/{p}.svg\" alt=\"{p}\" style=\"max-width:100%\"></p>\n");
+    }
+    h += "</body></html>\n";
+    h
+}
+
 /// A file stem for an output name.
 fn stem(name: &str) -> String {
     name.chars()
@@ -189,7 +261,11 @@ fn stem(name: &str) -> String {
 }
 
 /// Histogram (as a step line, 30 bins) and empirical CDF of one output's finite values.
-fn distribution_plots(dir: &mut OutputDir, name: &str, values: &[f64]) -> Result<(), OutputError> {
+fn distribution_plots(
+    dir: &mut OutputDir,
+    name: &str,
+    values: &[f64],
+) -> Result<bool, OutputError> {
     let s = crate::montecarlo::stats::sorted(
         &values
             .iter()
@@ -198,7 +274,7 @@ fn distribution_plots(dir: &mut OutputDir, name: &str, values: &[f64]) -> Result
             .collect::<Vec<_>>(),
     );
     let (Some(&lo), Some(&hi)) = (s.first(), s.last()) else {
-        return Ok(());
+        return Ok(false);
     };
     let n = s.len() as f64;
     let cdf: Vec<(f64, f64)> = (s.iter().enumerate())
@@ -235,11 +311,12 @@ fn distribution_plots(dir: &mut OutputDir, name: &str, values: &[f64]) -> Result
         (name, "runs"),
         &[(name.to_string(), hist)],
         false,
-    )
+    )?;
+    Ok(true)
 }
 
 /// plots/torque_margin: every hinge's worst margin over its travel, with the 100 % line.
-fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<(), OutputError> {
+fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<bool, OutputError> {
     let mut series: Vec<Series> = (margins.iter().enumerate())
         .map(|(h, m)| {
             let pts = (m.iter().enumerate())
@@ -250,7 +327,7 @@ fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<(), OutputEr
         })
         .collect();
     if series.iter().all(|s| s.1.is_empty()) {
-        return Ok(()); // no friction: unbounded margins
+        return Ok(false); // no friction: unbounded margins
     }
     series.push(("100 %".to_string(), vec![(0.0, 100.0), (1.0, 100.0)]));
     line_chart(
@@ -260,7 +337,8 @@ fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<(), OutputEr
         ("fraction of the hinge travel", "margin [%]"),
         &series,
         false,
-    )
+    )?;
+    Ok(true)
 }
 
 /// Writes a folder: the scenario text, shard.json, runs.csv and torque_margin.csv; when the
@@ -297,13 +375,22 @@ pub fn write_montecarlo(
     plotted.push("final_latch_time");
     plotted.sort_unstable();
     plotted.dedup();
+    let mut stems = Vec::new();
     for name in plotted {
         if let Some(k) = names.iter().position(|n| n == name) {
             let v: Vec<f64> = records.iter().map(|r| r.outputs[k]).collect();
-            distribution_plots(dir, name, &v)?;
+            if distribution_plots(dir, name, &v)? {
+                stems.extend([
+                    format!("hist_{}", stem(name)),
+                    format!("cdf_{}", stem(name)),
+                ]);
+            }
         }
     }
-    margin_plot(dir, margins)?;
+    if margin_plot(dir, margins)? {
+        stems.push("torque_margin".into());
+    }
+    dir.write("report.html", report(info, &a, &stems))?;
     Ok(Some(a))
 }
 
