@@ -358,6 +358,17 @@ fn prop_shards_merged_and_thread_counts_equal_the_unsharded_run_byte_for_byte() 
         "2/3".as_ref(),
     ]));
     assert!(files(&dir.join("auto")) == files(&manual));
+    // AWS Batch's index with --shards N, likewise.
+    let o = bin()
+        .args(["montecarlo".as_ref(), scen.as_os_str(), "--out".as_ref()])
+        .arg(dir.join("aws"))
+        .args(["--shard", "auto", "--shards", "3"])
+        .env_remove("SLURM_ARRAY_TASK_ID")
+        .env("AWS_BATCH_JOB_ARRAY_INDEX", "2")
+        .output()
+        .unwrap();
+    ok(&o);
+    assert!(files(&dir.join("aws")) == files(&manual));
 }
 
 /// runs.csv rows as (run, values as bit patterns).
