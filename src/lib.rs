@@ -132,6 +132,7 @@ pub mod export;
 pub mod finite;
 pub mod limits;
 pub mod math;
+pub mod montecarlo;
 #[cfg(feature = "cli")]
 pub mod output;
 pub mod response;

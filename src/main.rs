@@ -4,6 +4,8 @@
 // No function over 120 lines (clippy.toml), as in the library.
 #![warn(clippy::too_many_lines)]
 
+mod mc_cli;
+
 use clap::{Parser, Subcommand};
 use flexcraft::deploy::Deployment;
 use flexcraft::output::{self, OutputDir};
@@ -86,6 +88,11 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Monte Carlo dispersions of the deployment ([montecarlo]; docs/montecarlo.md): runs
+    /// with dispersed values, requirement verdicts by order statistics, sharding for
+    /// clusters (`--shard I/N | auto`, then `montecarlo merge DIR… --out DIR`).
+    #[command(after_help = UNITS)]
+    Montecarlo(mc_cli::Args),
 }
 
 fn main() -> ExitCode {
@@ -102,6 +109,7 @@ fn main() -> ExitCode {
             open,
             quiet,
         } => run_simulate(&common, open, quiet),
+        Command::Montecarlo(a) => mc_cli::run(&a),
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
 }

@@ -21,6 +21,7 @@ mod suite {
     pub mod hardening_output;
     pub mod implicit;
     pub mod modal_properties;
+    pub mod montecarlo;
     pub mod mutations;
     pub mod output_dir;
     pub mod plates;

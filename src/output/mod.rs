@@ -8,6 +8,7 @@ mod export;
 pub(crate) mod figures;
 pub mod flex42;
 mod modes;
+mod montecarlo;
 mod names;
 pub(crate) mod plot;
 pub(crate) mod raster;
@@ -23,6 +24,9 @@ pub use atomic::{OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, deployment_csv, write_deploy};
 pub use export::{export_json, export_table, flex_body_name, write_export};
 pub use modes::{modes_json, modes_table, write_modes};
+pub use montecarlo::{
+    fingerprint, merge_shards, montecarlo_table, write_montecarlo, MergeError, Merged, ShardInfo,
+};
 pub use names::file_stems;
 pub use report::report_html;
 pub use simulate::{simulate_json, simulate_table, write_simulate};

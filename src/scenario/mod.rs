@@ -12,6 +12,7 @@ mod export;
 mod hub;
 mod masses;
 mod materials;
+mod montecarlo;
 mod overrides;
 mod plates;
 mod raw;
@@ -47,6 +48,8 @@ pub struct Scenario {
     /// component gives no `terms` or `[ritz] tolerance` is set (then `structure` has the
     /// chosen counts).
     pub term_selection: Option<crate::ritz::refine::TermSelection>,
+    /// The `[montecarlo]` section (docs/montecarlo.md), when present.
+    pub montecarlo: Option<crate::montecarlo::MonteCarlo>,
     /// Where each component was written, to locate a failure found after parsing.
     sources: Sources,
 }
@@ -60,6 +63,8 @@ struct Sources {
     at: BTreeMap<ComponentId, (String, Location)>,
     /// Keys located after parsing (`response.output_rate`, …): the value, or its section.
     keys: BTreeMap<&'static str, Location>,
+    /// Where each `[montecarlo.dispersions]` entry was written.
+    dispersions: Vec<(String, Location)>,
 }
 
 impl Scenario {
@@ -309,6 +314,10 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(d) => Some(deployment::lower(cx, d, &structure)?),
         None => None,
     };
+    let montecarlo = match &raw.montecarlo {
+        Some(m) => Some(montecarlo::lower(cx, m, &structure, deployment.as_ref())?),
+        None => None,
+    };
     Ok(Scenario {
         name,
         structure,
@@ -316,6 +325,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         response,
         export,
         term_selection,
+        montecarlo,
         sources: sources(cx, &raw),
     })
 }
@@ -391,6 +401,7 @@ fn sources(cx: &Ctx, raw: &RawScenario) -> Sources {
         );
     }
     let mut keys = BTreeMap::new();
+    let mut dispersions = Vec::new();
     if let Some(r) = &raw.response {
         let span = context::span_or(&r.get_ref().output_rate, r.span());
         keys.insert("response.output_rate", loc(span));
@@ -403,7 +414,13 @@ fn sources(cx: &Ctx, raw: &RawScenario) -> Sources {
         let span = context::span_or(&e.get_ref().damping_ratio, e.span());
         keys.insert("export.damping_ratio", loc(span));
     }
+    if let Some(m) = &raw.montecarlo {
+        for (path, d) in &m.get_ref().dispersions {
+            dispersions.push((path.clone(), loc(d.span())));
+        }
+    }
     Sources {
+        dispersions,
         file: cx.file.to_string(),
         text: cx.src.to_string(),
         at,

@@ -26,6 +26,7 @@ pub struct RawScenario {
     pub deployment: Option<S<RawDeployment>>,
     pub response: Option<S<RawResponse>>,
     pub export: Option<S<RawExport>>,
+    pub montecarlo: Option<S<RawMonteCarlo>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
@@ -314,4 +315,38 @@ pub struct RawPoint {
 pub struct RawTransfer {
     pub input: S<String>,
     pub output: S<String>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawMonteCarlo {
+    pub runs: Option<S<i64>>,
+    pub seed: Option<S<i64>>,
+    /// Keyed by dotted path (sorted: the order of the draws).
+    #[serde(default)]
+    pub dispersions: BTreeMap<String, S<RawDispersion>>,
+    #[serde(default)]
+    pub requirements: Vec<S<RawRequirement>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDispersion {
+    pub normal: Option<S<Vec<f64>>>,
+    pub uniform: Option<S<Vec<f64>>>,
+    pub lognormal: Option<S<Vec<f64>>>,
+    pub choice: Option<S<Vec<f64>>>,
+    pub weights: Option<S<Vec<f64>>>,
+    pub truncate: Option<S<Vec<f64>>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawRequirement {
+    pub name: S<String>,
+    pub output: S<String>,
+    pub min: Option<S<f64>>,
+    pub max: Option<S<f64>>,
+    pub probability: S<f64>,
+    pub confidence: S<f64>,
 }

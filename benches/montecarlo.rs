@@ -1,0 +1,35 @@
+//! The per-run overhead of a Monte Carlo run (docs/montecarlo.md, "Speed"): applying the
+//! drawn values to the scenario text and validating it again (what every run does before its
+//! deployment) against the deployment run itself, for the seed deployment of
+//! examples/montecarlo.toml (rigid base). `cargo bench --bench montecarlo`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use flexcraft::montecarlo::{output_names, run_one};
+use flexcraft::Scenario;
+use std::time::Duration;
+
+fn bench(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/montecarlo.toml");
+    let s = Scenario::from_file(std::path::Path::new(path)).expect("example parses");
+    let mc = s.montecarlo.clone().expect("[montecarlo]");
+    let names = output_names(&s.structure, s.deployment.as_ref().unwrap()).len();
+    let mut g = c.benchmark_group("montecarlo");
+    g.sample_size(20).measurement_time(Duration::from_secs(5));
+    let mut i = 0;
+    g.bench_function("overhead: draw, apply and validate", |b| {
+        b.iter(|| {
+            i += 1;
+            s.with_values(&mc.overrides(i)).expect("valid")
+        })
+    });
+    g.bench_function("whole run (draw, apply, deploy, outputs)", |b| {
+        b.iter(|| {
+            i += 1;
+            run_one(&s, &mc, names, i)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

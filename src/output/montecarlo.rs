@@ -1,0 +1,642 @@
+//! The files of a Monte Carlo run, a shard and a merge (docs/montecarlo.md): scenario.toml,
+//! shard.json (the fingerprint of scenario, seed and runs), runs.csv, torque_margin.csv and,
+//! once every run is there, summary.json and the plots; the terminal table; reading shards
+//! back and merging them.
+//!
+//! A merge recomputes everything from the rows it reads: every number is written in its
+//! shortest round-trip form, so the rows read back are the f64 the runs produced, and the
+//! merged folder is byte-identical to the unsharded run's.
+
+use super::plot::{line_chart, Series};
+use super::{num, OutputDir, OutputError};
+use crate::montecarlo::{
+    analyse, output_names, worst_margins, Analysis, MonteCarlo, RunRecord, RunStatus, Summary,
+    MARGIN_POINTS,
+};
+use crate::Scenario;
+use serde_json::{json, Value};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What a shard folder holds besides its rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShardInfo {
+    /// SHA-256 of the scenario text, the seed and the run count.
+    pub hash: String,
+    /// Seed.
+    pub seed: u64,
+    /// Runs of the whole analysis.
+    pub runs: u64,
+    /// This shard (0-based).
+    pub shard: u64,
+    /// Shards of the analysis.
+    pub shards: u64,
+}
+
+/// The fingerprint written with every shard: SHA-256 of the scenario text, the seed and the
+/// number of runs (shards of different analyses are never merged).
+pub fn fingerprint(text: &str, mc: &MonteCarlo) -> String {
+    let mut h = Sha256::new();
+    h.update(text.as_bytes());
+    h.update(format!("\nseed={}\nruns={}\n", mc.seed, mc.runs).as_bytes());
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// runs.csv: run, status, every applied value, every output.
+fn runs_csv(
+    mc: &MonteCarlo,
+    names: &[String],
+    records: &[RunRecord],
+) -> Result<Vec<u8>, OutputError> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let csv_err = |e: csv::Error| OutputError::Io(std::io::Error::other(e.to_string()));
+    let mut header = vec!["run".to_string(), "status".to_string()];
+    header.extend(mc.dispersions.iter().map(|d| d.path.clone()));
+    header.extend(names.iter().cloned());
+    w.write_record(&header).map_err(csv_err)?;
+    for r in records {
+        let mut row = vec![r.index.to_string(), r.status.name().to_string()];
+        row.extend(r.applied.iter().map(|v| num(*v)));
+        row.extend(r.outputs.iter().map(|v| num(*v)));
+        w.write_record(&row).map_err(csv_err)?;
+    }
+    w.into_inner()
+        .map_err(|e| OutputError::Io(std::io::Error::other(e.to_string())))
+}
+
+/// torque_margin.csv: per fraction of the travel, every hinge's worst margin.
+fn margin_csv(margins: &[Vec<f64>]) -> String {
+    let mut s = String::from("travel fraction");
+    for h in 1..=margins.len() {
+        s += &format!(",hinge {h} margin");
+    }
+    s.push('\n');
+    for j in 0..MARGIN_POINTS {
+        s += &num(j as f64 / (MARGIN_POINTS - 1) as f64);
+        for m in margins {
+            s += &format!(",{}", num(m[j]));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+fn summary_json(s: &Summary) -> Value {
+    let pct: serde_json::Map<String, Value> = (crate::montecarlo::stats::PERCENTILES.iter())
+        .zip(&s.percentiles)
+        .map(|(p, v)| (format!("p{p}"), json!(v)))
+        .collect();
+    json!({
+        "count": s.count, "non_finite": s.non_finite, "mean": s.mean, "sd": s.sd,
+        "min": s.min, "max": s.max, "percentiles": pct,
+    })
+}
+
+fn ranked(r: &[(String, f64)]) -> Value {
+    Value::Array(
+        r.iter()
+            .map(|(p, rho)| json!({"parameter": p, "spearman": rho}))
+            .collect(),
+    )
+}
+
+/// summary.json.
+pub fn summary(info: &ShardInfo, a: &Analysis, margins: &[Vec<f64>]) -> String {
+    let verdicts: Vec<Value> = (a.verdicts.iter())
+        .map(|v| {
+            let q = &v.requirement;
+            json!({
+                "name": q.name, "output": q.output, "min": q.min, "max": q.max,
+                "probability": q.probability, "confidence": q.confidence,
+                "runs": v.runs, "failures": v.failures, "failures_allowed": v.allowed,
+                "runs_needed": v.runs_needed, "met": v.met,
+                "tolerance_bound": v.tolerance_bound,
+                "failure_drivers": ranked(&v.drivers),
+            })
+        })
+        .collect();
+    let named = |xs: &[(String, Summary)]| -> serde_json::Map<String, Value> {
+        xs.iter()
+            .map(|(n, s)| (n.clone(), summary_json(s)))
+            .collect()
+    };
+    let worst: Vec<Value> = (margins.iter().enumerate())
+        .map(|(h, m)| {
+            let least = m.iter().copied().fold(f64::INFINITY, f64::min);
+            json!({"hinge": h + 1, "least_margin": least, "meets_100_percent": least >= 1.0})
+        })
+        .collect();
+    let v = json!({
+        "hash": info.hash, "seed": info.seed, "runs": info.runs,
+        "status": a.status_counts.iter().map(|(s, n)| (s.to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
+        "requirements": verdicts,
+        "applied": named(&a.applied),
+        "outputs": named(&a.outputs),
+        "sensitivity": a.sensitivity.iter().map(|(n, r)| (n.clone(), ranked(r))).collect::<serde_json::Map<_, _>>(),
+        "torque_margin": worst,
+        "notes": {
+            "percentiles": "linear interpolation between order statistics (Hyndman & Fan type 7), over the finite values",
+            "verdict": "order statistics (Wilks): met when failures ≤ failures_allowed at probability and confidence; a refused or failed run is a failure",
+            "sensitivity": "Spearman rank correlation of each dispersed parameter with the output, largest |ρ| first",
+            "torque_margin": "static margin k(α_ref − α)/μ − 1 over the travel, worst case over the runs (null: no friction, unbounded)",
+        },
+    });
+    serde_json::to_string_pretty(&v).expect("JSON of plain values") + "\n"
+}
+
+/// The terminal table.
+pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
+    let mut s = format!("Monte Carlo: {} runs, seed {}\n", info.runs, info.seed);
+    for (st, n) in a.status_counts.iter().filter(|(_, n)| *n > 0) {
+        s += &format!("  {st}: {n}\n");
+    }
+    s += "\noutput                          mean          sd            min           p50           p99           max\n";
+    for (n, o) in &a.outputs {
+        s += &format!(
+            "{n:<30} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e}\n",
+            o.mean, o.sd, o.min, o.percentiles[3], o.percentiles[6], o.max
+        );
+    }
+    for v in &a.verdicts {
+        let q = &v.requirement;
+        s += &format!(
+            "\nrequirement \"{}\" ({} {}{}, p = {}, c = {}): {} — {} failures in {} runs, {} allowed; {} runs would allow the observed failures\n",
+            q.name,
+            q.output,
+            q.min.map_or(String::new(), |m| format!("≥ {m} ")),
+            q.max.map_or(String::new(), |m| format!("≤ {m}")),
+            q.probability,
+            q.confidence,
+            if v.met { "MET" } else { "NOT MET" },
+            v.failures,
+            v.runs,
+            v.allowed.map_or("none (too few runs)".to_string(), |f| f.to_string()),
+            v.runs_needed,
+        );
+        if let Some((p, rho)) = v.drivers.first().filter(|d| d.1.is_finite()) {
+            s += &format!("  strongest driver of failures: {p} (Spearman ρ = {rho:.3})\n");
+        }
+    }
+    s
+}
+
+/// Text for HTML.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A number for the report (4 significant digits; "–" for a missing one).
+fn sig(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.4e}")
+    } else if v.is_nan() {
+        "–".into()
+    } else {
+        format!("{v}")
+    }
+}
+
+/// report.html: the Monte Carlo section — verdicts, statistics, sensitivity, plots (linked
+/// from plots/).
+pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
+    let mut h = String::from(
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>Monte Carlo</title>\n\
+         <style>body{font-family:sans-serif;max-width:70em;margin:2em auto}td,th{padding:2px 8px;text-align:right}\
+         td:first-child,th:first-child{text-align:left}.met{color:#070}.not{color:#b00}</style></head><body>\n",
+    );
+    h += &format!(
+        "<h1>Monte Carlo dispersions</h1>\n<p>{} runs, seed {}; fingerprint <code>{}</code>.</p>\n",
+        info.runs, info.seed, info.hash
+    );
+    h += "<h2>Requirements (order statistics)</h2>\n<table><tr><th>requirement</th><th>output</th><th>bound</th><th>p / c</th><th>failures</th><th>allowed</th><th>runs needed</th><th>tolerance bound</th><th>verdict</th><th>strongest driver</th></tr>\n";
+    for v in &a.verdicts {
+        let q = &v.requirement;
+        let bound = match (q.min, q.max) {
+            (Some(lo), Some(hi)) => format!("{lo} … {hi}"),
+            (Some(lo), None) => format!("≥ {lo}"),
+            (None, Some(hi)) => format!("≤ {hi}"),
+            (None, None) => String::new(),
+        };
+        let driver = v
+            .drivers
+            .first()
+            .filter(|d| d.1.is_finite())
+            .map_or(String::new(), |(p, r)| format!("{} (ρ = {r:.3})", esc(p)));
+        h += &format!(
+            "<tr><td>{}</td><td>{}</td><td>{bound}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{}\">{}</td><td>{driver}</td></tr>\n",
+            esc(&q.name), esc(&q.output), q.probability, q.confidence, v.failures,
+            v.allowed.map_or("none".into(), |f| f.to_string()), v.runs_needed,
+            v.tolerance_bound.map_or("–".into(), sig),
+            if v.met { "met" } else { "not" }, if v.met { "met" } else { "not met" },
+        );
+    }
+    h += "</table>\n<h2>Outputs</h2>\n<table><tr><th>output</th><th>mean</th><th>sd</th><th>min</th><th>p50</th><th>p99</th><th>max</th><th>strongest parameter</th></tr>\n";
+    for ((n, o), (_, rank)) in a.outputs.iter().zip(&a.sensitivity) {
+        let top = rank
+            .first()
+            .filter(|d| d.1.is_finite())
+            .map_or(String::new(), |(p, r)| format!("{} ({r:.3})", esc(p)));
+        h += &format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{top}</td></tr>\n",
+            esc(n), sig(o.mean), sig(o.sd), sig(o.min), sig(o.percentiles[3]), sig(o.percentiles[6]), sig(o.max)
+        );
+    }
+    h += "</table>\n<h2>Plots</h2>\n";
+    for p in plots {
+        h += &format!("<p><img src=\"plots/{p}.svg\" alt=\"{p}\" style=\"max-width:100%\"></p>\n");
+    }
+    h += "</body></html>\n";
+    h
+}
+
+/// A file stem for an output name.
+fn stem(name: &str) -> String {
+    name.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
+}
+
+/// Histogram (as a step line, 30 bins) and empirical CDF of one output's finite values.
+fn distribution_plots(
+    dir: &mut OutputDir,
+    name: &str,
+    values: &[f64],
+) -> Result<bool, OutputError> {
+    let s = crate::montecarlo::stats::sorted(
+        &values
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .collect::<Vec<_>>(),
+    );
+    let (Some(&lo), Some(&hi)) = (s.first(), s.last()) else {
+        return Ok(false);
+    };
+    let n = s.len() as f64;
+    let cdf: Vec<(f64, f64)> = (s.iter().enumerate())
+        .flat_map(|(i, &x)| [(x, i as f64 / n), (x, (i + 1) as f64 / n)])
+        .collect();
+    line_chart(
+        dir,
+        &format!("cdf_{}", stem(name)),
+        &format!("{name}: empirical CDF"),
+        (name, "fraction of runs"),
+        &[(name.to_string(), cdf)],
+        false,
+    )?;
+    let bins = 30;
+    let width = if hi > lo {
+        (hi - lo) / bins as f64
+    } else {
+        1.0
+    };
+    let mut count = vec![0usize; bins];
+    for x in &s {
+        count[(((x - lo) / width) as usize).min(bins - 1)] += 1;
+    }
+    let mut hist: Vec<(f64, f64)> = vec![(lo, 0.0)];
+    for (b, c) in count.iter().enumerate() {
+        let (x0, x1) = (lo + b as f64 * width, lo + (b + 1) as f64 * width);
+        hist.extend([(x0, *c as f64), (x1, *c as f64)]);
+    }
+    hist.push((lo + bins as f64 * width, 0.0));
+    line_chart(
+        dir,
+        &format!("hist_{}", stem(name)),
+        &format!("{name}: histogram ({bins} bins)"),
+        (name, "runs"),
+        &[(name.to_string(), hist)],
+        false,
+    )?;
+    Ok(true)
+}
+
+/// plots/torque_margin: every hinge's worst margin over its travel, with the 100 % line.
+fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<bool, OutputError> {
+    let mut series: Vec<Series> = (margins.iter().enumerate())
+        .map(|(h, m)| {
+            let pts = (m.iter().enumerate())
+                .filter(|(_, v)| v.is_finite())
+                .map(|(j, v)| (j as f64 / (MARGIN_POINTS - 1) as f64, 100.0 * v))
+                .collect();
+            (format!("hinge {}", h + 1), pts)
+        })
+        .collect();
+    if series.iter().all(|s| s.1.is_empty()) {
+        return Ok(false); // no friction: unbounded margins
+    }
+    series.push(("100 %".to_string(), vec![(0.0, 100.0), (1.0, 100.0)]));
+    line_chart(
+        dir,
+        "torque_margin",
+        "static torque margin, worst case over the runs",
+        ("fraction of the hinge travel", "margin [%]"),
+        &series,
+        false,
+    )?;
+    Ok(true)
+}
+
+/// Writes a folder: the scenario text, shard.json, runs.csv and torque_margin.csv; when the
+/// folder holds every run (one shard of one), also summary.json and the plots (the outputs
+/// the requirements name, and final_latch_time). Returns the analysis of complete folders.
+pub fn write_montecarlo(
+    dir: &mut OutputDir,
+    scenario_text: &str,
+    info: &ShardInfo,
+    mc: &MonteCarlo,
+    names: &[String],
+    records: &[RunRecord],
+    margins: &[Vec<f64>],
+) -> Result<Option<Analysis>, OutputError> {
+    dir.write("scenario.toml", scenario_text)?;
+    let shard = json!({
+        "format": "flexcraft Monte Carlo shard, version 1",
+        "hash": info.hash, "seed": info.seed, "runs": info.runs,
+        "shard": info.shard, "shards": info.shards,
+        "split": "run i belongs to shard i mod shards",
+    });
+    dir.write(
+        "shard.json",
+        serde_json::to_string_pretty(&shard).expect("plain JSON") + "\n",
+    )?;
+    dir.write("runs.csv", runs_csv(mc, names, records)?)?;
+    dir.write("torque_margin.csv", margin_csv(margins))?;
+    if info.shards != 1 {
+        return Ok(None);
+    }
+    let a = analyse(mc, names, records);
+    dir.write("summary.json", summary(info, &a, margins))?;
+    let mut plotted: Vec<&str> = mc.requirements.iter().map(|q| q.output.as_str()).collect();
+    plotted.push("final_latch_time");
+    plotted.sort_unstable();
+    plotted.dedup();
+    let mut stems = Vec::new();
+    for name in plotted {
+        if let Some(k) = names.iter().position(|n| n == name) {
+            let v: Vec<f64> = records.iter().map(|r| r.outputs[k]).collect();
+            if distribution_plots(dir, name, &v)? {
+                stems.extend([
+                    format!("hist_{}", stem(name)),
+                    format!("cdf_{}", stem(name)),
+                ]);
+            }
+        }
+    }
+    if margin_plot(dir, margins)? {
+        stems.push("torque_margin".into());
+    }
+    dir.write("report.html", report(info, &a, &stems))?;
+    Ok(Some(a))
+}
+
+/// Why shards could not be merged.
+#[derive(Debug, Error)]
+pub enum MergeError {
+    /// A file could not be read.
+    #[error("{}: {reason}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// A file is not what a shard writes.
+    #[error("{}:{line}: {reason}", path.display())]
+    Malformed {
+        /// The file.
+        path: PathBuf,
+        /// Its line (1-based; 0: the whole file).
+        line: usize,
+        /// Why.
+        reason: String,
+    },
+    /// Shards of different analyses, or an incomplete or overlapping set.
+    #[error("{}: {reason}", path.display())]
+    Mismatch {
+        /// The shard folder.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
+/// One shard read back.
+struct Shard {
+    info: ShardInfo,
+    text: String,
+    records: Vec<RunRecord>,
+    margins: Vec<Vec<f64>>,
+}
+
+fn read(path: &Path) -> Result<String, MergeError> {
+    std::fs::read_to_string(path).map_err(|e| MergeError::Read {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+fn parse_num(s: &str, path: &Path, line: usize) -> Result<f64, MergeError> {
+    s.parse().map_err(|_| MergeError::Malformed {
+        path: path.to_path_buf(),
+        line,
+        reason: format!("{s:?} is not a number"),
+    })
+}
+
+fn read_info(dir: &Path) -> Result<ShardInfo, MergeError> {
+    let path = dir.join("shard.json");
+    let bad = |reason: &str| MergeError::Malformed {
+        path: path.clone(),
+        line: 0,
+        reason: reason.to_string(),
+    };
+    let v: Value = serde_json::from_str(&read(&path)?).map_err(|e| bad(&e.to_string()))?;
+    let u = |k: &str| {
+        v[k].as_u64()
+            .ok_or_else(|| bad(&format!("no integer {k:?}")))
+    };
+    Ok(ShardInfo {
+        hash: v["hash"]
+            .as_str()
+            .ok_or_else(|| bad("no \"hash\""))?
+            .to_string(),
+        seed: u("seed")?,
+        runs: u("runs")?,
+        shard: u("shard")?,
+        shards: u("shards")?,
+    })
+}
+
+fn read_shard(dir: &Path, k_applied: usize, k_out: usize) -> Result<Shard, MergeError> {
+    let info = read_info(dir)?;
+    let text = read(&dir.join("scenario.toml"))?;
+    let path = dir.join("runs.csv");
+    let body = read(&path)?;
+    let mut rd = csv::Reader::from_reader(body.as_bytes());
+    let mut records = Vec::new();
+    for (i, row) in rd.records().enumerate() {
+        let line = i + 2;
+        let bad = |reason: String| MergeError::Malformed {
+            path: path.clone(),
+            line,
+            reason,
+        };
+        let row = row.map_err(|e| bad(e.to_string()))?;
+        if row.len() != 2 + k_applied + k_out {
+            return Err(bad(format!(
+                "{} columns, the scenario gives {}",
+                row.len(),
+                2 + k_applied + k_out
+            )));
+        }
+        let nums = (2..row.len())
+            .map(|c| parse_num(&row[c], &path, line))
+            .collect::<Result<Vec<f64>, _>>()?;
+        records.push(RunRecord {
+            index: row[0]
+                .parse()
+                .map_err(|_| bad(format!("run {:?}", &row[0])))?,
+            status: RunStatus::from_name(&row[1])
+                .ok_or_else(|| bad(format!("status {:?}", &row[1])))?,
+            applied: nums[..k_applied].to_vec(),
+            outputs: nums[k_applied..].to_vec(),
+            margins: Vec::new(),
+        });
+    }
+    let mpath = dir.join("torque_margin.csv");
+    let mtext = read(&mpath)?;
+    let mut margins: Vec<Vec<f64>> = Vec::new();
+    for (j, l) in mtext.lines().skip(1).enumerate() {
+        let cells: Vec<&str> = l.split(',').skip(1).collect();
+        if margins.is_empty() {
+            margins = vec![Vec::new(); cells.len()];
+        }
+        for (h, c) in cells.iter().enumerate() {
+            let v = parse_num(c, &mpath, j + 2)?;
+            margins
+                .get_mut(h)
+                .ok_or_else(|| MergeError::Malformed {
+                    path: mpath.clone(),
+                    line: j + 2,
+                    reason: "a ragged row".into(),
+                })?
+                .push(v);
+        }
+    }
+    Ok(Shard {
+        info,
+        text,
+        records,
+        margins,
+    })
+}
+
+/// Everything a merge writes.
+pub struct Merged {
+    /// The scenario text.
+    pub text: String,
+    /// The shard info of the whole (shard 0 of 1).
+    pub info: ShardInfo,
+    /// The analysis settings (runs from the shards).
+    pub mc: MonteCarlo,
+    /// Output names.
+    pub names: Vec<String>,
+    /// Every run, by index.
+    pub records: Vec<RunRecord>,
+    /// The worst margins.
+    pub margins: Vec<Vec<f64>>,
+}
+
+/// Reads shard folders and merges them: the same analysis (hash), the same shard count,
+/// every shard exactly once.
+pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
+    let first = dirs.first().ok_or_else(|| MergeError::Mismatch {
+        path: PathBuf::from("."),
+        reason: "no shard folders given".into(),
+    })?;
+    let text = read(&first.join("scenario.toml"))?;
+    let file = first.join("scenario.toml").display().to_string();
+    let s = Scenario::from_toml_str(&text, &file).map_err(|e| MergeError::Malformed {
+        path: first.join("scenario.toml"),
+        line: e.location.line,
+        reason: format!("{}: {}", e.key, e.reason),
+    })?;
+    let (Some(d), Some(mut mc)) = (s.deployment.as_ref(), s.montecarlo.clone()) else {
+        return Err(MergeError::Mismatch {
+            path: first.clone(),
+            reason: "scenario.toml has no [deployment] and [montecarlo]".into(),
+        });
+    };
+    let names = output_names(&s.structure, d);
+    let first_info = read_info(first)?;
+    mc.runs = first_info.runs;
+    let mut seen = vec![false; first_info.shards as usize];
+    let mut records = Vec::new();
+    let mut curves = Vec::new();
+    for dir in dirs {
+        let sh = read_shard(dir, mc.dispersions.len(), names.len())?;
+        let mismatch = |reason: String| MergeError::Mismatch {
+            path: dir.clone(),
+            reason,
+        };
+        if sh.info.hash != first_info.hash || sh.text != text {
+            return Err(mismatch(format!(
+                "a shard of another analysis (hash {} ≠ {}): the scenario, seed or run count differ",
+                sh.info.hash, first_info.hash
+            )));
+        }
+        if sh.info.shards != first_info.shards || sh.info.shard >= sh.info.shards {
+            return Err(mismatch(format!(
+                "shard {}/{} does not belong to a split into {} shards",
+                sh.info.shard, sh.info.shards, first_info.shards
+            )));
+        }
+        if std::mem::replace(&mut seen[sh.info.shard as usize], true) {
+            return Err(mismatch(format!("shard {} is given twice", sh.info.shard)));
+        }
+        if sh.margins.len() != d.chain.hinges.len() {
+            return Err(mismatch(
+                "torque_margin.csv does not match the hinges".into(),
+            ));
+        }
+        let expected = mc.shard_runs(sh.info.shard, sh.info.shards);
+        if sh
+            .records
+            .iter()
+            .map(|r| r.index)
+            .ne(expected.iter().copied())
+        {
+            return Err(mismatch(format!(
+                "runs.csv does not hold exactly the runs of shard {}/{}",
+                sh.info.shard, sh.info.shards
+            )));
+        }
+        records.extend(sh.records);
+        curves.push(sh.margins);
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return Err(MergeError::Mismatch {
+            path: first.clone(),
+            reason: format!("shard {missing} of {} is missing", first_info.shards),
+        });
+    }
+    records.sort_by_key(|r| r.index);
+    let margins = worst_margins(d.chain.hinges.len(), &curves);
+    Ok(Merged {
+        text,
+        info: ShardInfo {
+            shard: 0,
+            shards: 1,
+            ..first_info
+        },
+        mc,
+        names,
+        records,
+        margins,
+    })
+}
