@@ -167,6 +167,11 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
     if let Some(i) = a.run {
         return one_run(path, &s, &mc, i, out, a.force);
     }
+    if a.shards.is_some() && a.shard.as_deref() != Some("auto") {
+        return Err(refuse(
+            "--shards N goes with --shard auto (the array size under AWS Batch); with --shard I/N the count is N",
+        ));
+    }
     let (shard, shards) = match a.shard.as_deref() {
         None => (0, 1),
         Some("auto") => auto_shard(a.shards).map_err(refuse)?,

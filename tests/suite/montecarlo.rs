@@ -585,6 +585,15 @@ fn prop_bad_input_is_located_and_refused_with_nothing_written() {
     );
     refused(
         &dir,
+        "shards",
+        &base,
+        &["--shard", "1/4", "--shards", "4"],
+        None,
+        "--shards",
+        "goes with --shard auto",
+    );
+    refused(
+        &dir,
         "run",
         &base,
         &["--run", "10"],
