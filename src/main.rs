@@ -9,6 +9,7 @@ mod mc_cli;
 use clap::{Parser, Subcommand};
 use flexcraft::deploy::Deployment;
 use flexcraft::output::{self, OutputDir};
+use flexcraft::scenario::default_memory_budget;
 use flexcraft::{ModalAnalysis, RitzModel, Scenario};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -134,19 +135,6 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
     } else {
         Err(format!("not a size: {s:?} (e.g. 4G, 512M, 1000000)"))
     }
-}
-
-/// Half of the machine's memory (Linux: MemTotal of /proc/meminfo), or 8 GiB when unknown.
-fn default_memory_budget() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|m| {
-            m.lines()
-                .find(|l| l.starts_with("MemTotal:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(8 << 30, |kb| kb * 1024 / 2)
 }
 
 /// Exit statuses: 2 the input was refused (the scenario, a missing section the command

@@ -13,6 +13,7 @@ use flexcraft::export::ExportModel;
 use flexcraft::faer::Mat;
 use flexcraft::output::{self, OutputDir};
 use flexcraft::ritz::shapes::{attachment_of, BeamStation, PlatePoint};
+use flexcraft::scenario::default_memory_budget;
 use flexcraft::scenario::{ErrorKind, OverrideValue, ScenarioError as RustScenarioError};
 use flexcraft::simulation::Simulation;
 use flexcraft::structure::ComponentId;
@@ -143,19 +144,6 @@ fn compute<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, Failure> + Sen
         })
     });
     r.map_err(|e| e.into_py(py))
-}
-
-/// Half of the machine's memory, the command line's default budget (src/main.rs).
-fn default_memory_budget() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|m| {
-            m.lines()
-                .find(|l| l.starts_with("MemTotal:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(8 << 30, |kb| kb * 1024 / 2)
 }
 
 /// A validated scenario (the library's `Scenario`) and the name it was read under.

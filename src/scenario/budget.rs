@@ -18,6 +18,20 @@ use crate::structure::ComponentId;
 pub const MATRICES_PER_SOLVE: u64 = 20;
 /// Bytes of CSV text per number written (`1.2345678901234567e-5,`), rounded up.
 pub const CSV_BYTES_PER_NUMBER: u64 = 24;
+
+/// The default memory budget of a run: half of the machine's memory (Linux: MemTotal of
+/// /proc/meminfo), or 8 GiB when unknown.
+pub fn default_memory_budget() -> u64 {
+    std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|m| {
+            m.lines()
+                .find(|l| l.starts_with("MemTotal:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<u64>().ok())
+        })
+        .map_or(8 << 30, |kb| kb * 1024 / 2)
+}
 /// Memory of the program itself, bytes.
 pub const BASELINE_BYTES: u64 = 32 << 20;
 
