@@ -694,18 +694,7 @@ impl PySimulation {
         let r = self.sim.response.as_ref()?;
         let hist = &r.history;
         // The columns of write_simulate's response.csv, in its order.
-        let mut header = vec!["t [s]".to_string(), "t_after_latch [s]".to_string()];
-        header.extend(
-            r.channels
-                .iter()
-                .map(|ch| format!("{} [{}]", ch.name, ch.unit)),
-        );
-        header.extend(
-            r.modal
-                .modes
-                .iter()
-                .map(|m| format!("eta_{} [√kg·m]", m.number)),
-        );
+        let header = output::response_header(r);
         let (nc, nm) = (r.channels.len(), r.modal.modes.len());
         let t_latch = r.handover.latch_time;
         let a = Array2::from_shape_fn((hist.times.len(), 2 + nc + nm), |(k, j)| match j {

@@ -29,7 +29,7 @@ pub use montecarlo::{
 };
 pub use names::file_stems;
 pub use report::report_html;
-pub use simulate::{simulate_json, simulate_table, write_simulate};
+pub use simulate::{response_header, simulate_json, simulate_table, write_simulate};
 pub use sweep::{sweep_json, sweep_table, write_sweep};
 
 use thiserror::Error;

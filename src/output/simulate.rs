@@ -152,6 +152,24 @@ fn peak_loads(sim: &Simulation) -> Value {
     json!({"root_loads": roots, "latch_moments": latches})
 }
 
+/// The columns of response.csv, in order: t from release (one timeline with deployment.csv)
+/// and from the final latch, every channel with its unit, the modal amplitudes.
+pub fn response_header(r: &Response) -> Vec<String> {
+    let mut header = vec!["t [s]".to_string(), "t_after_latch [s]".to_string()];
+    header.extend(
+        r.channels
+            .iter()
+            .map(|ch| format!("{} [{}]", ch.name, ch.unit)),
+    );
+    header.extend(
+        r.modal
+            .modes
+            .iter()
+            .map(|m| format!("eta_{} [√kg·m]", m.number)),
+    );
+    header
+}
+
 /// summary.json (and `simulate --json`).
 pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
     let d = s.deployment.as_ref();
@@ -495,19 +513,7 @@ pub fn write_simulate(
     let hist = &r.history;
     let file = std::fs::File::create(dir.path("response.csv")?)?;
     let mut w = csv_writer(std::io::BufWriter::with_capacity(1 << 16, file));
-    // t from release (one timeline with deployment.csv) and from the final latch.
-    let mut header = vec!["t [s]".to_string(), "t_after_latch [s]".to_string()];
-    header.extend(
-        r.channels
-            .iter()
-            .map(|ch| format!("{} [{}]", ch.name, ch.unit)),
-    );
-    header.extend(
-        r.modal
-            .modes
-            .iter()
-            .map(|m| format!("eta_{} [√kg·m]", m.number)),
-    );
+    let header = response_header(r);
     let csv_err = |e: csv::Error| OutputError::Io(std::io::Error::other(e));
     w.write_record(&header).map_err(csv_err)?;
     let t_latch = r.handover.latch_time;
