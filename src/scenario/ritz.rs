@@ -44,6 +44,17 @@ pub(super) fn select(
         .collect();
     let r = raw.ritz.as_ref().map(|r| r.get_ref());
     let tolerance = r.and_then(|r| r.tolerance.as_ref());
+    // The ranges hold whether or not a selection runs (every component with its own terms
+    // and no tolerance: `modes` and `max_dof` then have nothing to steer, but a value out of
+    // range is still a mistake in the file).
+    let given_modes = match r.and_then(|r| r.modes.as_ref()) {
+        Some(m) => Some(int_in(cx, m, "ritz.modes", 1, L::MAX_RITZ_MODES)?),
+        None => None,
+    };
+    let given_max_dof = match r.and_then(|r| r.max_dof.as_ref()) {
+        Some(m) => Some((int_in(cx, m, "ritz.max_dof", 7, L::MAX_RITZ_DOF)?, m)),
+        None => None,
+    };
     if automatic.is_empty() && tolerance.is_none() {
         return Ok(None);
     }
@@ -52,10 +63,7 @@ pub(super) fn select(
         Some(t) => cx.bounded(t, "ritz.tolerance", L::RITZ_TOLERANCE)?,
         None => d.tolerance,
     };
-    let modes = match r.and_then(|r| r.modes.as_ref()) {
-        Some(m) => int_in(cx, m, "ritz.modes", 1, L::MAX_RITZ_MODES)?,
-        None => used_modes.unwrap_or(d.modes).min(L::MAX_RITZ_MODES),
-    };
+    let modes = given_modes.unwrap_or_else(|| used_modes.unwrap_or(d.modes).min(L::MAX_RITZ_MODES));
     let given: usize = crate::ritz::HUB_DOF
         + (structure.beams().iter().enumerate())
             .filter(|(i, _)| !automatic.contains(&ComponentId::Beam(*i)))
@@ -65,9 +73,8 @@ pub(super) fn select(
             .filter(|(i, _)| !automatic.contains(&ComponentId::Plate(*i)))
             .map(|(_, p)| p.terms.dof())
             .sum::<usize>();
-    let max_dof = match r.and_then(|r| r.max_dof.as_ref()) {
-        Some(m) => {
-            let n = int_in(cx, m, "ritz.max_dof", 7, L::MAX_RITZ_DOF)?;
+    let max_dof = match given_max_dof {
+        Some((n, m)) => {
             if n < given {
                 return Err(cx.invalid(
                     m.span(),

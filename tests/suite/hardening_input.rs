@@ -615,6 +615,32 @@ fn ritz_accuracy_keys_are_refused_with_location() {
         let line = line_of(&src, to.lines().last().unwrap());
         assert_refused(&dir, &out, line, key, reason);
     }
+    // With every component's terms given and no tolerance the selection does not run; the
+    // ranges still hold (the seed gives every component its terms).
+    let seed = include_str!("../../examples/seed.toml");
+    for (to, key, reason) in [
+        (
+            "basis = \"legendre\"\nmodes = 0",
+            "ritz.modes",
+            "from 1 to 500",
+        ),
+        (
+            "basis = \"legendre\"\nmax_dof = -5",
+            "ritz.max_dof",
+            "from 7 to 4000",
+        ),
+        (
+            "basis = \"legendre\"\nmax_dof = 5000",
+            "ritz.max_dof",
+            "from 7 to 4000",
+        ),
+    ] {
+        let src = seed.replacen("basis = \"legendre\"", to, 1);
+        assert!(src != seed, "{to}");
+        let out = run(&dir, "modes", &src, &[]);
+        let line = line_of(&src, to.lines().last().unwrap());
+        assert_refused(&dir, &out, line, key, reason);
+    }
     // Given terms larger than the limit.
     let src = base
         .replacen(
