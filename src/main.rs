@@ -9,7 +9,7 @@ mod mc_cli;
 use clap::{Parser, Subcommand};
 use flexcraft::deploy::Deployment;
 use flexcraft::output::{self, OutputDir};
-use flexcraft::scenario::default_memory_budget;
+use flexcraft::scenario::{default_memory_budget, RunParts};
 use flexcraft::{ModalAnalysis, RitzModel, Scenario};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -175,13 +175,13 @@ const FAILED: u8 = 1;
 
 /// Reads and validates the scenario and checks that the run fits the memory budget,
 /// reporting a refusal with its location.
-fn load(c: &Common) -> Result<Scenario, ExitCode> {
+fn load(c: &Common, parts: RunParts) -> Result<Scenario, ExitCode> {
     let refuse = |e: flexcraft::scenario::ScenarioError| {
         eprintln!("error: {e}");
         ExitCode::from(REFUSED)
     };
     let s = Scenario::from_file(&c.scenario).map_err(refuse)?;
-    s.check_budget(c.max_memory.unwrap_or_else(default_memory_budget))
+    s.check_budget_for(c.max_memory.unwrap_or_else(default_memory_budget), parts)
         .map_err(refuse)?;
     Ok(s)
 }
@@ -291,7 +291,12 @@ fn run_sweep(
 
 fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
-    let scenario = load(c)?;
+    let parts = if sweep.is_some() {
+        RunParts::DEPLOY
+    } else {
+        RunParts::MODES
+    };
+    let scenario = load(c, parts)?;
     let staged = prepare(out, c.force)?;
     let model = RitzModel::assemble(&scenario.structure);
     // With an automatic term selection only the modes it aimed at are solved for (the higher
@@ -338,7 +343,7 @@ fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
 fn run_export(c: &Common) -> Result<(), ExitCode> {
     use flexcraft::export::ExportModel;
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
-    let scenario = load(c)?;
+    let scenario = load(c, RunParts::MODES)?;
     let staged = prepare(out, c.force)?;
     let model = RitzModel::assemble(&scenario.structure);
     let wanted = scenario.export_modes();
@@ -388,7 +393,7 @@ fn run_export(c: &Common) -> Result<(), ExitCode> {
 
 fn run_deploy(c: &Common) -> Result<(), ExitCode> {
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
-    let scenario = load(c)?;
+    let scenario = load(c, RunParts::DEPLOY)?;
     let d = need_deployment(path, &scenario)?;
     let staged = prepare(out, c.force)?;
     let (coupled, result) =
@@ -411,7 +416,7 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let started = std::time::Instant::now();
     let progress = Progress::new(quiet);
-    let scenario = load(c)?;
+    let scenario = load(c, RunParts::SIMULATE)?;
     need_deployment(path, &scenario)?;
     // The report's footer carries the SHA-256 of the text that was parsed (read once).
     let source = scenario.source_text().as_bytes().to_vec();

@@ -79,24 +79,59 @@ pub fn format_bytes(b: u64) -> String {
     }
 }
 
+/// The parts of a run a command makes: every command solves the modal model; `deploy` (and
+/// `modes --deployment-sweep`) also keeps the deployment's time series, `simulate` both time
+/// series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunParts {
+    /// The deployment's time series.
+    pub deployment: bool,
+    /// The response's time series.
+    pub response: bool,
+}
+
+impl RunParts {
+    /// `simulate`: the modal solve and both time series.
+    pub const SIMULATE: Self = Self {
+        deployment: true,
+        response: true,
+    };
+    /// `modes`, `export`: the modal solve alone.
+    pub const MODES: Self = Self {
+        deployment: false,
+        response: false,
+    };
+    /// `deploy`, `modes --deployment-sweep`: the modal solve and the deployment.
+    pub const DEPLOY: Self = Self {
+        deployment: true,
+        response: false,
+    };
+}
+
 impl Scenario {
     /// The cost of `simulate` on this scenario (an upper bound for `modes` and `deploy`).
     pub fn estimate(&self) -> Estimate {
+        self.estimate_for(RunParts::SIMULATE)
+    }
+
+    /// The cost of the parts of a run a command makes.
+    pub fn estimate_for(&self, parts: RunParts) -> Estimate {
         let st = &self.structure;
         let dof = 6
             + st.beams.iter().map(|b| b.terms.dof() as u64).sum::<u64>()
             + st.plates.iter().map(|p| p.terms.dof() as u64).sum::<u64>();
         let modes_bytes = MATRICES_PER_SOLVE.saturating_mul(8 * dof * dof);
-        let deployment_cells = self.deployment.as_ref().map_or(0, |d| {
-            let n = d.chain.len() as u64;
-            // t, α, α̇, hub (3 + 3), reactions (2N), moments (N), energies, hinge points
-            // (2(N + 1)): one sample, plus a copy at every latch.
-            let per_sample = 10 + 8 * n;
-            crate::response::rows(d.end_time, d.output_rate)
-                .saturating_add(2 * n)
-                .saturating_mul(per_sample)
-        });
-        let response_cells = if self.deployment.is_some() {
+        let deployment_cells =
+            (self.deployment.as_ref().filter(|_| parts.deployment)).map_or(0, |d| {
+                let n = d.chain.len() as u64;
+                // t, α, α̇, hub (3 + 3), reactions (2N), moments (N), energies, hinge points
+                // (2(N + 1)): one sample, plus a copy at every latch.
+                let per_sample = 10 + 8 * n;
+                crate::response::rows(d.end_time, d.output_rate)
+                    .saturating_add(2 * n)
+                    .saturating_mul(per_sample)
+            });
+        let response_cells = if self.deployment.is_some() && parts.response {
             // Hub (6), every beam's tip (3) and root loads (6), plate corners (2), latch
             // moments (one per panel); η and η̈ of every kept mode.
             let panels = self.deployment.as_ref().map_or(0, |d| d.chain.len() as u64);
@@ -120,7 +155,17 @@ impl Scenario {
     /// that drives it: the component with the most Ritz terms, or the output rate of the
     /// longest time series.
     pub fn check_budget(&self, max_bytes: u64) -> Result<Estimate, ScenarioError> {
-        let e = self.estimate();
+        self.check_budget_for(max_bytes, RunParts::SIMULATE)
+    }
+
+    /// [`Scenario::check_budget`] for the parts of a run a command makes: `modes` is not
+    /// refused for a response it does not compute.
+    pub fn check_budget_for(
+        &self,
+        max_bytes: u64,
+        parts: RunParts,
+    ) -> Result<Estimate, ScenarioError> {
+        let e = self.estimate_for(parts);
         let peak = e.peak_bytes();
         if peak <= max_bytes {
             return Ok(e);

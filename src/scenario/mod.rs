@@ -19,7 +19,7 @@ mod raw;
 mod response;
 mod ritz;
 
-pub use budget::{default_memory_budget, format_bytes, Estimate};
+pub use budget::{default_memory_budget, format_bytes, Estimate, RunParts};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
 pub use error::{ErrorKind, Location, ScenarioError};
 pub use overrides::{apply_overrides, OverrideValue};

@@ -266,6 +266,18 @@ fn a_run_over_the_memory_budget_is_refused_before_it_starts() {
     let err = s.check_budget(256 << 20).unwrap_err();
     assert_eq!(err.key, "response.output_rate");
     assert_eq!(err.location.line, line_of(&long, "output_rate = 50.0"));
+    // Commands that make no response are not refused for it: `modes` and `export` budget
+    // the modal solve, `deploy` the deployment too.
+    use flexcraft::scenario::RunParts;
+    for parts in [RunParts::MODES, RunParts::DEPLOY] {
+        let e = s.check_budget_for(256 << 20, parts).unwrap();
+        assert_eq!(e.response_cells, 0);
+    }
+    assert!(s.check_budget_for(256 << 20, RunParts::SIMULATE).is_err());
+    let out = run(&dir, "modes", &long, &["--max-memory", "256M"]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let out = run(&dir, "simulate", &long, &["--max-memory", "256M"]);
+    assert_eq!(out.status.code(), Some(2), "{out:?}");
 }
 
 #[test]
