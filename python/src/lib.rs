@@ -295,6 +295,12 @@ enum ModesSource {
     Simulation(Arc<Simulation>),
 }
 
+/// Where `Modes.shape` samples: a station of a beam or a point of a plate.
+enum ShapePoint {
+    Beam(BeamStation),
+    Plate(PlatePoint),
+}
+
 impl PyModes {
     fn model(&self) -> &RitzModel {
         match &self.src {
@@ -385,18 +391,18 @@ impl PyModes {
         points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         guard(|| {
-            let st = &self.model().structure;
-            let m = &self.modes().modes;
+            let model = self.model();
+            let st = &model.structure;
             let beam = st.beams().iter().position(|b| b.name() == component);
             let plate = st.plates().iter().position(|p| p.name() == component);
-            let samples: Vec<Vec<[f64; 6]>> = if let Some(b) = beam {
+            let (id, at): (ComponentId, Vec<ShapePoint>) = if let Some(b) = beam {
                 let xs: PyReadonlyArray1<f64> = points.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
                         "shape: \"{component}\" is a beam: points is a 1-D float array of ξ = x/L"
                     ))
                 })?;
-                let xs = xs.as_slice()?.to_vec();
-                let stations = xs
+                let at = xs
+                    .as_slice()?
                     .iter()
                     .map(|&xi| {
                         if !(0.0..=1.0).contains(&xi) {
@@ -404,25 +410,17 @@ impl PyModes {
                                 "shape: ξ = {xi} is outside [0, 1]"
                             )));
                         }
-                        BeamStation::new(self.model(), b, xi)
+                        BeamStation::new(model, b, xi)
+                            .map(ShapePoint::Beam)
                             .ok_or_else(|| PyValueError::new_err("shape: no such beam"))
                     })
                     .collect::<PyResult<Vec<_>>>()?;
-                m.iter()
-                    .map(|mode| {
-                        let att = attachment_of(self.model(), ComponentId::Beam(b), &mode.shape)
-                            .unwrap_or_default();
-                        stations
-                            .iter()
-                            .map(|s| six(s.sample(self.model(), &mode.shape, att)))
-                            .collect()
-                    })
-                    .collect()
+                (ComponentId::Beam(b), at)
             } else if let Some(p) = plate {
                 let xy: PyReadonlyArray2<f64> = points.extract().map_err(|_| {
                     PyTypeError::new_err(format!(
-                    "shape: \"{component}\" is a plate: points is an n × 2 float array of (ξ, η)"
-                ))
+                        "shape: \"{component}\" is a plate: points is an n × 2 float array of (ξ, η)"
+                    ))
                 })?;
                 let xy = xy.as_array();
                 if xy.ncols() != 2 {
@@ -430,7 +428,7 @@ impl PyModes {
                         "shape: a plate's points are n × 2 (ξ, η)",
                     ));
                 }
-                let pts = xy
+                let at = xy
                     .rows()
                     .into_iter()
                     .map(|r| {
@@ -440,19 +438,12 @@ impl PyModes {
                                 "shape: (ξ, η) = ({xi}, {eta}) is outside [0, 1]²"
                             )));
                         }
-                        PlatePoint::new(self.model(), p, xi, eta)
+                        PlatePoint::new(model, p, xi, eta)
+                            .map(ShapePoint::Plate)
                             .ok_or_else(|| PyValueError::new_err("shape: no such plate"))
                     })
                     .collect::<PyResult<Vec<_>>>()?;
-                m.iter()
-                    .map(|mode| {
-                        let att = attachment_of(self.model(), ComponentId::Plate(p), &mode.shape)
-                            .unwrap_or_default();
-                        pts.iter()
-                            .map(|s| six(s.sample(self.model(), &mode.shape, att)))
-                            .collect()
-                    })
-                    .collect()
+                (ComponentId::Plate(p), at)
             } else {
                 let names: Vec<&str> = st
                     .beams()
@@ -464,9 +455,21 @@ impl PyModes {
                     "shape: no beam or plate is named {component:?} (the model has {names:?})"
                 )));
             };
-            let n = samples.first().map_or(0, Vec::len);
-            let flat: Vec<f64> = samples.iter().flatten().flatten().copied().collect();
-            let a = numpy::ndarray::Array3::from_shape_vec((m.len(), n, 6), flat)
+            let m = &self.modes().modes;
+            let mut flat = Vec::with_capacity(m.len() * at.len() * 6);
+            for mode in m {
+                let q = &mode.shape;
+                let att = attachment_of(model, id, q).unwrap_or_default();
+                for point in &at {
+                    let p = match point {
+                        ShapePoint::Beam(s) => s.sample(model, q, att),
+                        ShapePoint::Plate(s) => s.sample(model, q, att),
+                    };
+                    let (d, r) = (p.displacement.0, p.rotation.0);
+                    flat.extend([d[0], d[1], d[2], r[0], r[1], r[2]]);
+                }
+            }
+            let a = numpy::ndarray::Array3::from_shape_vec((m.len(), at.len(), 6), flat)
                 .map_err(|e| InternalError::new_err(e.to_string()))?;
             Ok(a.into_pyarray(py).into_any())
         })
@@ -479,11 +482,6 @@ impl PyModes {
             output::write_modes(o, self.model(), self.modes())
         })
     }
-}
-
-fn six(p: flexcraft::ritz::shapes::PointSample) -> [f64; 6] {
-    let (d, r) = (p.displacement, p.rotation);
-    [d.0[0], d.0[1], d.0[2], r.0[0], r.0[1], r.0[2]]
 }
 
 /// Stages, writes and swaps in an output folder as the command line does.

@@ -122,16 +122,24 @@ def parse(text: str, name: str):
         return None
 
 
+def computed(label: str, f):
+    """f(), or None when it raised a documented failure (counted as a hypothesis event)."""
+    try:
+        r = f()
+    except (fc.ScenarioError, fc.ComputationError) as e:
+        assert str(e)
+        event(f"{label}: {type(e).__name__}")
+        return None
+    event(f"{label}: ran")
+    return r
+
+
 def exercise_modes(sc) -> None:
     """fc.modes, and every attribute made from its Rust result (pickling makes them all),
     to_dict and mode shapes."""
-    try:
-        m = fc.modes(sc, max_memory=MAX_MEMORY)
-    except (fc.ScenarioError, fc.ComputationError) as e:
-        assert str(e)
-        event(f"modes: {type(e).__name__}")
+    m = computed("modes", lambda: fc.modes(sc, max_memory=MAX_MEMORY))
+    if m is None:
         return
-    event("modes: ran")
     assert len(pickle.loads(pickle.dumps(m)).to_dict()["modes"]) == len(m)
     for name in sc.beams[:1]:
         assert m.shape(name, [0.0, 0.5, 1.0]).shape == (len(m), 3, 6)
@@ -170,14 +178,12 @@ def test_mutated_deployments_never_panic(name, edits):
     sc = parse(mutate(EXAMPLE_TEXTS[name], edits), name)
     if sc is None or not sc.has_deployment:
         return
-    try:
-        sc = sc.with_values({"deployment.end_time": 1.0})
-        d = fc.deploy(sc, max_memory=MAX_MEMORY)
-    except (fc.ScenarioError, fc.ComputationError) as e:
-        assert str(e)
-        event(f"deploy: {type(e).__name__}")
+    d = computed(
+        "deploy",
+        lambda: fc.deploy(sc.with_values({"deployment.end_time": 1.0}), max_memory=MAX_MEMORY),
+    )
+    if d is None:
         return
-    event("deploy: ran")
     d2 = pickle.loads(pickle.dumps(d))
     assert d2.to_dict() == d.to_dict()
     assert len(d.columns["t [s]"]) == len(d.t)
