@@ -14,20 +14,29 @@ rad/s (``omega``). Each function does what the command of the same name does, wi
 library calls: ``to_dict()`` / ``summary`` equal the command's ``--json`` output, ``columns``
 and ``response`` its CSV files, and ``write(dir)`` writes the files of ``--out dir``.
 
+A result holds the Rust result; each attribute is made (a NumPy array, a list, a dict) when
+it is first read, then kept. Neither ``import flexcraft`` nor a computation imports NumPy:
+the first array read does.
+
 Computations release the GIL (threads run in parallel); every object pickles (a scenario as
 its TOML text, a result as its arrays), so process pools can ship them.
 """
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass
-from typing import Dict, List, Optional
-
-import numpy as np
+import math
 
 from . import _flexcraft as _native
 from ._flexcraft import ComputationError, InternalError, ScenarioError
+
+# For type checkers only: NumPy (about 100 ms to import), typing and dataclasses are not
+# imported with the package (the annotations are strings: `from __future__ import
+# annotations`).
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any, Callable, Dict, List, Optional
+
+    import numpy as np
 
 __version__ = _native.__version__
 
@@ -137,38 +146,151 @@ class Scenario:
         return f"Scenario({self.name!r}, file={self.file!r})"
 
 
+class _Lazy:
+    """A result's attribute, made from the Rust result when first read, then kept in the
+    instance (a non-data descriptor: the instance's value wins from then on).
+
+    ``make(result)`` builds it; by default the native handle's ``field(name)``. A
+    ``pickled`` attribute is made before pickling, so that the unpickled result has it
+    without the native handle; the others are made again from what was pickled, or by
+    computing again (``Deployment.columns``).
+    """
+
+    def __init__(self, doc: str, make: Optional[Callable[[Any], Any]], pickled: bool) -> None:
+        self.__doc__ = doc
+        self.make = make
+        self.pickled = pickled
+        self.name = ""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj: Any, owner: Optional[type] = None) -> Any:
+        if obj is None:
+            return self
+        value = obj._handle().field(self.name) if self.make is None else self.make(obj)
+        obj.__dict__[self.name] = value
+        return value
+
+
+def _lazy(doc: str, make: Optional[Callable[[Any], Any]] = None, pickled: bool = True) -> Any:
+    """An attribute made on first read (:class:`_Lazy`); typed ``Any`` so that the class
+    body's annotation (``omega: np.ndarray = _lazy(...)``) is the attribute's type."""
+    return _Lazy(doc, make, pickled)
+
+
 class _Result:
-    """What every result shares: the scenario, the arrays, and the native handle (kept in
-    memory, not pickled: after unpickling, what needs it — ``write``, mode shapes — runs the
-    computation again, which gives the same numbers bit for bit)."""
+    """What every result shares: its scenario, the native handle on the Rust result, the
+    attributes made from it on first read, ``to_dict``, ``write`` and pickling.
 
-    _native_fields: tuple = ()
+    The handle is kept in memory, not pickled: a result pickles as its attributes (all made
+    first), and after unpickling what needs the handle — ``write``, ``Modes.shape``,
+    ``Deployment.columns`` — runs the computation again, which gives the same numbers bit
+    for bit (the library is deterministic).
+    """
 
-    def __getstate__(self):
+    #: The command, and native function, that makes the result.
+    _command = ""
+    #: Its index in ``_native.simulate(...).parts()``, for the modes and deployment of a
+    #: simulation.
+    _part = -1
+    #: The attributes made before pickling (every `_lazy` with pickled=True).
+    _pickled: tuple = ()
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._pickled = tuple(
+            name
+            for klass in reversed(cls.__mro__)
+            for name, v in vars(klass).items()
+            if isinstance(v, _Lazy) and v.pickled
+        )
+
+    def __init__(self, scenario: Scenario, handle: Any, via: str = "") -> None:
+        self.scenario = scenario
+        self._h = handle
+        self._via = via or self._command
+
+    def _handle(self) -> Any:
+        if self._h is None:
+            made = getattr(_native, self._via)(self.scenario._s)
+            self._h = made if self._via == self._command else made.parts()[self._part]
+        return self._h
+
+    _json: str = _lazy("The command's --json text.", lambda r: r._handle().json())
+
+    def to_dict(self) -> dict:
+        """The command's ``--json`` object, which is also the JSON file its ``--out``
+        writes: ``modes`` → modes.json, ``deploy`` → events.json, ``simulate`` →
+        summary.json, ``export`` → model.json. A new dict each call."""
+        import json
+
+        return json.loads(self._json)
+
+    def write(self, dir: Any, force: bool = False) -> int:
+        """Writes the files (and, for a simulation, the report) of ``flexcraft <command>
+        --out dir`` and returns how many. The folder appears whole or not at all; an
+        existing folder that flexcraft did not write is refused (``OSError``) unless
+        ``force``."""
+        import os
+
+        return self._handle().write(os.fspath(dir), force)
+
+    def __getstate__(self) -> dict:
+        for name in self._pickled:
+            getattr(self, name)
         state = dict(self.__dict__)
         state.pop("_h", None)
         return state
 
-    def __setstate__(self, state):
+    def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         self._h = None
 
-    def _handle(self):
-        if self._h is None:
-            self._h = self._recompute()
-        return self._h
 
+class _Record:
+    """A small immutable record of named values (floats, lists, NumPy arrays), compared
+    value by value (``np.array_equal``); pickles as its values. The subclasses list their
+    fields in ``_fields`` (and ``__slots__``)."""
 
-def _modes_handle(scenario: Scenario, via: str):
-    if via == "simulate":
-        return _native.simulate(scenario._s).parts()[0]
-    return _native.modes(scenario._s)
+    __slots__ = ()
+    _fields: tuple = ()
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        values = dict(zip(self._fields, args))
+        values.update(kwargs)
+        if len(args) > len(self._fields) or set(values) != set(self._fields):
+            raise TypeError(f"{type(self).__name__} takes the fields {', '.join(self._fields)}")
+        for name in self._fields:
+            object.__setattr__(self, name, values[name])
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"{type(self).__name__} is immutable")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"{type(self).__name__} is immutable")
+
+    def __reduce__(self) -> tuple:
+        return (type(self), tuple(getattr(self, f) for f in self._fields))
+
+    def __eq__(self, other: object) -> bool:
+        if type(other) is not type(self):
+            return NotImplemented
+        import numpy as np
+
+        return all(np.array_equal(getattr(self, f), getattr(other, f)) for f in self._fields)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{f}={getattr(self, f)!r}" for f in self._fields)
+        return f"{type(self).__name__}({fields})"
 
 
 class Modes(_Result):
     """The natural modes of the deployed spacecraft (``flexcraft modes``).
 
-    Attributes (NumPy arrays; one entry per mode, rigid modes first):
+    Attributes (NumPy arrays, made on first read; one entry per mode, rigid modes first):
 
     - ``number``: 1-based mode numbers;
     - ``frequency_hz`` [Hz], ``omega`` [rad/s];
@@ -182,37 +304,35 @@ class Modes(_Result):
     - ``participation``: the signed L_d of the same modes [kg^½, kg^½·m];
     - ``hub_fixed_omega`` [rad/s]; ``appendage_mass``: the limit of the effective-mass
       sums, 6 directions.
+
+    ``to_dict()`` is ``flexcraft modes --json`` (= modes.json).
     """
 
-    def __init__(self, scenario: Scenario, handle, via: str = "modes") -> None:
-        self.scenario = scenario
-        self._via = via
-        self._h = handle
-        a = handle.arrays()
-        self.number: np.ndarray = a["number"]
-        self.frequency_hz: np.ndarray = a["frequency_hz"]
-        self.omega: np.ndarray = a["omega"]
-        self.rigid: np.ndarray = a["rigid"]
-        self.coefficients: np.ndarray = a["coefficients"]
-        self.mass_matrix: np.ndarray = a["mass_matrix"]
-        self.stiffness_matrix: np.ndarray = a["stiffness_matrix"]
-        self.effective_mass: np.ndarray = a["effective_mass"]
-        self.participation: np.ndarray = a["participation"]
-        self.hub_fixed_omega: np.ndarray = a["hub_fixed_omega"]
-        self.appendage_mass: np.ndarray = a["appendage_mass"]
-        self._json: str = handle.json()
+    _command = "modes"
+    _part = 0
 
-    def _recompute(self):
-        return _modes_handle(self.scenario, self._via)
+    number: np.ndarray = _lazy("1-based mode numbers (int64).")
+    frequency_hz: np.ndarray = _lazy("Natural frequencies [Hz].")
+    omega: np.ndarray = _lazy("Natural circular frequencies [rad/s].")
+    rigid: np.ndarray = _lazy("True for a rigid-body (zero-frequency) mode.")
+    coefficients: np.ndarray = _lazy(
+        "Modes × coordinates: the mass-normalised Ritz coefficients (ΦᵀMΦ = I)."
+    )
+    mass_matrix: np.ndarray = _lazy("The assembled Ritz mass matrix M.")
+    stiffness_matrix: np.ndarray = _lazy("The assembled Ritz stiffness matrix K.")
+    effective_mass: np.ndarray = _lazy(
+        "Hub-fixed elastic modes × 6: effective masses x, y, z [kg], rx, ry, rz [kg·m²]."
+    )
+    participation: np.ndarray = _lazy(
+        "Hub-fixed elastic modes × 6: the signed participation L_d [kg^½, kg^½·m]."
+    )
+    hub_fixed_omega: np.ndarray = _lazy("The hub-fixed modes' ω [rad/s].")
+    appendage_mass: np.ndarray = _lazy("The effective-mass sums' limit, 6 directions.")
 
     def __len__(self) -> int:
-        return len(self.omega)
+        return len(self.number)
 
-    def to_dict(self) -> dict:
-        """The ``flexcraft modes --json`` object (= modes.json)."""
-        return json.loads(self._json)
-
-    def shape(self, component: str, points, mode: Optional[int] = None) -> np.ndarray:
+    def shape(self, component: str, points: Any, mode: Optional[int] = None) -> np.ndarray:
         """Mode shapes of a beam or plate at points.
 
         ``points``: for a beam, a 1-D array of ξ = x/L in [0, 1] (root to tip); for a
@@ -222,6 +342,8 @@ class Modes(_Result):
         unit mass-normalised modal coordinate — or points × 6 for one ``mode`` (its 1-based
         number).
         """
+        import numpy as np
+
         pts = np.ascontiguousarray(points, dtype=np.float64)
         if pts.ndim == 0:
             pts = pts.reshape(1)
@@ -233,18 +355,11 @@ class Modes(_Result):
             raise IndexError(f"no mode number {mode} (modes 1…{len(self)})")
         return s[idx[0]]
 
-    def write(self, dir, force: bool = False) -> int:
-        """Writes the files of ``flexcraft modes --out dir``; returns how many."""
-        import os
-
-        return self._handle().write(os.fspath(dir), force)
-
     def __repr__(self) -> str:
         return f"Modes({len(self)} modes of {self.scenario.name!r})"
 
 
-@dataclass(frozen=True, eq=False)
-class Latch:
+class Latch(_Record):
     """One latching (plastic impact) of the deployment.
 
     ``time`` [s]; ``hinge``: the hinge that reached its latch angle (1-based); ``locked``:
@@ -255,6 +370,18 @@ class Latch:
     carries [N·m·s].
     """
 
+    __slots__ = _fields = (
+        "time",
+        "hinge",
+        "locked",
+        "angles",
+        "rates_before",
+        "rates_after",
+        "energy_before",
+        "energy_after",
+        "energy_lost",
+        "hinge_impulses",
+    )
     time: float
     hinge: int
     locked: List[int]
@@ -266,21 +393,15 @@ class Latch:
     energy_lost: float
     hinge_impulses: np.ndarray
 
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Latch):
-            return NotImplemented
-        return all(
-            np.array_equal(getattr(self, f), getattr(other, f))
-            for f in self.__dataclass_fields__
-        )
 
-    __hash__ = None  # type: ignore[assignment]
+def _read_csv(text: str) -> Dict[str, np.ndarray]:
+    import numpy as np
 
-
-def _deploy_handle(scenario: Scenario, via: str):
-    if via == "simulate":
-        return _native.simulate(scenario._s).parts()[1]
-    return _native.deploy(scenario._s)
+    lines = text.splitlines()
+    header = lines[0].split(",")
+    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=np.float64)
+    data = data.reshape(len(lines) - 1, len(header))
+    return {h: data[:, j].copy() for j, h in enumerate(header)}
 
 
 class Deployment(_Result):
@@ -289,43 +410,28 @@ class Deployment(_Result):
     ``t`` [s] (samples), ``alpha`` [rad] and ``rate`` [rad/s] (samples × hinges, hinge 1
     at the root), ``latches`` (list of :class:`Latch`), ``all_latched``, ``final_time``
     [s]; ``columns``: every column of deployment.csv by its header name (units in
-    brackets); ``to_dict()``: the ``--json`` object (= events.json).
+    brackets); ``to_dict()``: the ``--json`` object (= events.json). Each is made on first
+    read.
     """
 
-    def __init__(self, scenario: Scenario, handle, via: str = "deploy") -> None:
-        self.scenario = scenario
-        self._via = via
-        self._h = handle
-        a = handle.arrays()
-        self.t: np.ndarray = a["t"]
-        self.alpha: np.ndarray = a["alpha"]
-        self.rate: np.ndarray = a["rate"]
-        self.latches: List[Latch] = [Latch(**latch) for latch in a["latches"]]
-        self.all_latched: bool = a["all_latched"]
-        self.final_time: float = a["final_time"]
-        self._json: str = handle.json()
-        self._columns: Optional[Dict[str, np.ndarray]] = None
+    _command = "deploy"
+    _part = 1
 
-    def _recompute(self):
-        return _deploy_handle(self.scenario, self._via)
-
-    @property
-    def columns(self) -> Dict[str, np.ndarray]:
-        """deployment.csv as a dict of arrays (header name → column), read from the text
-        the command writes, so the values are the file's to the last bit."""
-        if self._columns is None:
-            self._columns = _read_csv(self._handle().csv())
-        return self._columns
-
-    def to_dict(self) -> dict:
-        """The ``flexcraft deploy --json`` object (= events.json)."""
-        return json.loads(self._json)
-
-    def write(self, dir, force: bool = False) -> int:
-        """Writes the files of ``flexcraft deploy --out dir``; returns how many."""
-        import os
-
-        return self._handle().write(os.fspath(dir), force)
+    t: np.ndarray = _lazy("Sample times [s]: t = k/output_rate, plus two rows at every latch.")
+    alpha: np.ndarray = _lazy("Hinge angles [rad], samples × hinges (hinge 1 at the root).")
+    rate: np.ndarray = _lazy("Hinge rates [rad/s], samples × hinges.")
+    latches: List[Latch] = _lazy(
+        "The latch events, in time order (:class:`Latch`).",
+        lambda r: [Latch(**latch) for latch in r._handle().field("latches")],
+    )
+    all_latched: bool = _lazy("True when every hinge latched.")
+    final_time: float = _lazy("The time the deployment ended [s].")
+    columns: Dict[str, np.ndarray] = _lazy(
+        "deployment.csv as a dict of arrays (header name → column), read from the text the "
+        "command writes, so the values are the file's to the last bit.",
+        lambda r: _read_csv(r._handle().csv()),
+        pickled=False,
+    )
 
     def __repr__(self) -> str:
         return (
@@ -334,55 +440,48 @@ class Deployment(_Result):
         )
 
 
-def _read_csv(text: str) -> Dict[str, np.ndarray]:
-    lines = text.splitlines()
-    header = lines[0].split(",")
-    data = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]], dtype=np.float64)
-    data = data.reshape(len(lines) - 1, len(header))
-    return {h: data[:, j].copy() for j, h in enumerate(header)}
+def _response_columns(sim: Simulation) -> Dict[str, np.ndarray]:
+    r = sim._handle().response()
+    return {} if r is None else {h: r[1][:, j].copy() for j, h in enumerate(r[0])}
 
 
 class Simulation(_Result):
     """The whole story (``flexcraft simulate``): modes of the deployed spacecraft,
     deployment, hand-over at the final latch and the latch-excited response.
 
-    ``summary``: the ``--json`` object (= summary.json); ``response``: response.csv as a
-    dict of arrays by header name (empty when the run has no response, e.g. the array did
-    not latch); ``deployment`` (:class:`Deployment`), ``modes`` (:class:`Modes`).
+    ``summary``: the ``--json`` object (= summary.json, also ``to_dict()``); ``response``:
+    response.csv as a dict of arrays by header name (empty when the run has no response,
+    e.g. the array did not latch); ``deployment`` (:class:`Deployment`), ``modes``
+    (:class:`Modes`). Each is made on first read.
     """
 
-    def __init__(self, scenario: Scenario, handle) -> None:
-        self.scenario = scenario
-        self._h = handle
-        self.summary: dict = json.loads(handle.json())
-        r = handle.response()
-        self.response: Dict[str, np.ndarray] = (
-            {} if r is None else {h: r[1][:, j].copy() for j, h in enumerate(r[0])}
-        )
-        m, d = handle.parts()
-        self.modes = Modes(scenario, m, via="simulate")
-        self.deployment = Deployment(scenario, d, via="simulate")
+    _command = "simulate"
 
-    def _recompute(self):
-        return _native.simulate(self.scenario._s)
-
-    def write(self, dir, force: bool = False) -> int:
-        """Writes the files and report of ``flexcraft simulate --out dir`` (the folder
-        appears whole or not at all; an existing folder not written by flexcraft is refused
-        unless ``force``); returns how many files."""
-        import os
-
-        return self._handle().write(os.fspath(dir), force)
+    summary: dict = _lazy(
+        "The --json object (= summary.json).", lambda r: r.to_dict(), pickled=False
+    )
+    response: Dict[str, np.ndarray] = _lazy(
+        "response.csv as a dict of arrays by header name (empty without a response).",
+        _response_columns,
+    )
+    modes: Modes = _lazy(
+        "The deployed spacecraft's modes (all of them).",
+        lambda r: Modes(r.scenario, r._handle().parts()[0], via="simulate"),
+    )
+    deployment: Deployment = _lazy(
+        "The run's deployment.",
+        lambda r: Deployment(r.scenario, r._handle().parts()[1], via="simulate"),
+    )
 
     def __repr__(self) -> str:
         return f"Simulation({self.scenario.name!r})"
 
 
-@dataclass(frozen=True, eq=False)
-class SecondOrder:
+class SecondOrder(_Record):
     """The second-order modal form M η̈ + C η̇ + K η = B u, y = F η + G η̇ (M = I, the
     modes mass-normalised; C = diag(2ζω) [1/s], K = diag(ω²) [1/s²])."""
 
+    __slots__ = _fields = ("M", "C", "K", "B", "F", "G")
     M: np.ndarray
     C: np.ndarray
     K: np.ndarray
@@ -401,51 +500,43 @@ class LinearModel(_Result):
     ``effective_mass_fraction`` (6 × modes); ``total_mass`` [kg], ``center_of_mass`` [m],
     ``rigid_mass_reference``, ``rigid_mass_cm`` (6 × 6), ``appendage_mass``;
     ``site_positions`` [m] and ``site_shapes`` (mode shapes at the hub reference point and
-    the named points); ``warnings``; ``to_dict()`` (= model.json).
+    the named points); ``warnings``; ``to_dict()`` (= model.json). Each is made on first
+    read.
     """
 
-    def __init__(self, scenario: Scenario, handle) -> None:
-        self.scenario = scenario
-        self._h = handle
-        a = handle.arrays()
-        self.A: np.ndarray = a["A"]
-        self.B: np.ndarray = a["B"]
-        self.C: np.ndarray = a["C"]
-        self.D: np.ndarray = a["D"]
-        self.state_names: List[str] = a["state_names"]
-        self.input_names: List[str] = a["input_names"]
-        self.output_names: List[str] = a["output_names"]
-        self.second_order = SecondOrder(a["M2"], a["C2"], a["K2"], a["B2"], a["F"], a["G"])
-        self.omega: np.ndarray = a["omega"]
-        self.frequency_hz: np.ndarray = a["omega"] / (2.0 * np.pi)
-        self.damping_ratio: np.ndarray = a["damping_ratio"]
-        self.rigid: np.ndarray = a["rigid"]
-        self.hub_fixed_omega: np.ndarray = a["hub_fixed_omega"]
-        self.participation: np.ndarray = a["participation"]
-        self.effective_mass: np.ndarray = a["effective_mass"]
-        self.effective_mass_fraction: np.ndarray = a["effective_mass_fraction"]
-        self.total_mass: float = a["total_mass"]
-        self.center_of_mass: np.ndarray = a["center_of_mass"]
-        self.rigid_mass_reference: np.ndarray = a["rigid_mass_reference"]
-        self.rigid_mass_cm: np.ndarray = a["rigid_mass_cm"]
-        self.appendage_mass: np.ndarray = a["appendage_mass"]
-        self.site_positions: np.ndarray = a["site_positions"]
-        self.site_shapes: np.ndarray = a["site_shapes"]
-        self.warnings: List[str] = handle.warnings()
-        self._json: str = handle.json()
+    _command = "export"
 
-    def _recompute(self):
-        return _native.export(self.scenario._s)
-
-    def to_dict(self) -> dict:
-        """The ``flexcraft export --json`` object (= model.json)."""
-        return json.loads(self._json)
-
-    def write(self, dir, force: bool = False) -> int:
-        """Writes the files of ``flexcraft export --out dir``; returns how many."""
-        import os
-
-        return self._handle().write(os.fspath(dir), force)
+    A: np.ndarray = _lazy("State matrix of x = [η; η̇].")
+    B: np.ndarray = _lazy("Input matrix.")
+    C: np.ndarray = _lazy("Output matrix.")
+    D: np.ndarray = _lazy("Feed-through matrix.")
+    state_names: List[str] = _lazy("Names of the states x.")
+    input_names: List[str] = _lazy("Names of the inputs u.")
+    output_names: List[str] = _lazy("Names of the outputs y.")
+    second_order: SecondOrder = _lazy(
+        "The second-order form (:class:`SecondOrder`).",
+        lambda r: SecondOrder(*(r._handle().field(k) for k in ("M2", "C2", "K2", "B2", "F", "G"))),
+    )
+    omega: np.ndarray = _lazy("The kept modes' ω [rad/s].")
+    frequency_hz: np.ndarray = _lazy(
+        "The kept modes' frequencies [Hz].", lambda r: r.omega / (2.0 * math.pi), pickled=False
+    )
+    damping_ratio: np.ndarray = _lazy("The kept modes' damping ratios ζ.")
+    rigid: np.ndarray = _lazy("True for a kept rigid-body mode.")
+    hub_fixed_omega: np.ndarray = _lazy("The hub-fixed modes' ω [rad/s].")
+    participation: np.ndarray = _lazy("Participation factors of the hub-fixed modes (6 × modes).")
+    effective_mass: np.ndarray = _lazy("Effective masses of the hub-fixed modes (6 × modes).")
+    effective_mass_fraction: np.ndarray = _lazy(
+        "Effective masses as fractions of the appendage mass (6 × modes)."
+    )
+    total_mass: float = _lazy("Total mass [kg].")
+    center_of_mass: np.ndarray = _lazy("Centre of mass [m] (structure frame).")
+    rigid_mass_reference: np.ndarray = _lazy("6 × 6 rigid-body mass matrix about the reference point.")
+    rigid_mass_cm: np.ndarray = _lazy("6 × 6 rigid-body mass matrix about the centre of mass.")
+    appendage_mass: np.ndarray = _lazy("The effective-mass sums' limit, 6 directions.")
+    site_positions: np.ndarray = _lazy("The hub reference point and the named points [m].")
+    site_shapes: np.ndarray = _lazy("The mode shapes at the sites.")
+    warnings: List[str] = _lazy("The command's warnings (e.g. fewer modes than asked for).")
 
     def __repr__(self) -> str:
         return (
@@ -454,7 +545,7 @@ class LinearModel(_Result):
         )
 
 
-def _need(scenario) -> Scenario:
+def _need(scenario: Any) -> Scenario:
     if not isinstance(scenario, Scenario):
         raise TypeError(f"expected a flexcraft.Scenario, not {type(scenario).__name__}")
     return scenario

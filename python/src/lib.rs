@@ -23,6 +23,7 @@ use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString};
+use pyo3::IntoPyObjectExt;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -51,7 +52,9 @@ pyo3::create_exception!(
      scenario."
 );
 
-/// The Python exception for a refused scenario, its fields as attributes.
+/// The Python exception for a refused scenario, its fields as attributes. They live in the
+/// instance's `__dict__`, which `BaseException.__reduce__` pickles with the message: the
+/// exception round-trips through pickle (and so through process pools) whole.
 fn scenario_error(py: Python<'_>, e: &RustScenarioError) -> PyErr {
     let err = ScenarioError::new_err(e.to_string());
     let kind = match e.kind {
@@ -61,51 +64,13 @@ fn scenario_error(py: Python<'_>, e: &RustScenarioError) -> PyErr {
         _ => "invalid",
     };
     let v = err.value(py);
-    let set = |k: &str, o: PyObject| v.setattr(k, o);
-    let ok = set(
-        "file",
-        e.file
-            .clone()
-            .into_pyobject(py)
-            .unwrap()
-            .into_any()
-            .unbind(),
-    )
-    .and(set(
-        "line",
-        e.location
-            .line
-            .into_pyobject(py)
-            .unwrap()
-            .into_any()
-            .unbind(),
-    ))
-    .and(set(
-        "column",
-        e.location
-            .column
-            .into_pyobject(py)
-            .unwrap()
-            .into_any()
-            .unbind(),
-    ))
-    .and(set(
-        "key",
-        e.key.clone().into_pyobject(py).unwrap().into_any().unbind(),
-    ))
-    .and(set(
-        "reason",
-        e.reason
-            .clone()
-            .into_pyobject(py)
-            .unwrap()
-            .into_any()
-            .unbind(),
-    ))
-    .and(set(
-        "kind",
-        kind.into_pyobject(py).unwrap().into_any().unbind(),
-    ));
+    let set = |k: &str, o: PyResult<Bound<'_, PyAny>>| o.and_then(|o| v.setattr(k, o));
+    let ok = set("file", e.file.as_str().into_bound_py_any(py))
+        .and(set("line", e.location.line.into_bound_py_any(py)))
+        .and(set("column", e.location.column.into_bound_py_any(py)))
+        .and(set("key", e.key.as_str().into_bound_py_any(py)))
+        .and(set("reason", e.reason.as_str().into_bound_py_any(py)))
+        .and(set("kind", kind.into_bound_py_any(py)));
     match ok {
         Ok(()) => err,
         Err(e) => e,
@@ -124,9 +89,7 @@ impl Failure {
         match self {
             Failure::Scenario(e) => scenario_error(py, &e),
             Failure::Computation(m) => ComputationError::new_err(m),
-            Failure::Panic(m) => InternalError::new_err(format!(
-                "flexcraft panicked (a bug; please report it with the scenario): {m}"
-            )),
+            Failure::Panic(m) => internal_error(&m),
         }
     }
 }
@@ -134,16 +97,30 @@ impl Failure {
 /// Runs `f` without the GIL, a panic turned into [`Failure::Panic`].
 fn compute<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, Failure> + Send) -> PyResult<T> {
     let r = py.allow_threads(|| {
-        catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| {
-            let msg = p
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| p.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "(no message)".into());
-            Err(Failure::Panic(msg))
-        })
+        catch_unwind(AssertUnwindSafe(f))
+            .unwrap_or_else(|p| Err(Failure::Panic(panic_message(&*p))))
     });
     r.map_err(|e| e.into_py(py))
+}
+
+/// Runs `f` with the GIL (a result's conversion to Python objects), a panic turned into
+/// `InternalError` as in [`compute`], not into pyo3's `PanicException`.
+fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|p| Err(internal_error(&panic_message(&*p))))
+}
+
+/// What a panic said.
+fn panic_message(p: &(dyn std::any::Any + Send)) -> String {
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".into())
+}
+
+fn internal_error(msg: &str) -> PyErr {
+    InternalError::new_err(format!(
+        "flexcraft panicked (a bug; please report it with the scenario): {msg}"
+    ))
 }
 
 /// A validated scenario (the library's `Scenario`) and the name it was read under.
@@ -282,14 +259,28 @@ fn mat<'py>(py: Python<'py>, m: &Mat<f64>) -> Bound<'py, PyAny> {
         .into_any()
 }
 
-fn rows<'py, const N: usize>(py: Python<'py>, r: &[[f64; N]]) -> Bound<'py, PyAny> {
-    Array2::from_shape_fn((r.len(), N), |(i, j)| r[i][j])
+/// Rows of N numbers as an n × N array.
+fn rows<'py, const N: usize>(
+    py: Python<'py>,
+    r: impl IntoIterator<Item = [f64; N]>,
+) -> Bound<'py, PyAny> {
+    let flat: Vec<f64> = r.into_iter().flatten().collect();
+    let n = flat.len() / N;
+    Array2::from_shape_fn((n, N), |(i, j)| flat[i * N + j])
         .into_pyarray(py)
         .into_any()
 }
 
-fn vec1<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyAny> {
-    v.into_pyarray(py).into_any()
+fn vec1<'py>(py: Python<'py>, v: impl IntoIterator<Item = f64>) -> Bound<'py, PyAny> {
+    v.into_iter()
+        .collect::<Vec<f64>>()
+        .into_pyarray(py)
+        .into_any()
+}
+
+/// A field name the package does not know: a bug in flexcraft/__init__.py.
+fn no_field(what: &str, name: &str) -> PyErr {
+    InternalError::new_err(format!("flexcraft: a {what} result has no field {name:?}"))
 }
 
 /// The model and modes of `fc.modes`, kept for mode shapes at points and for writing.
@@ -302,6 +293,12 @@ struct PyModes {
 enum ModesSource {
     Own(Box<(RitzModel, ModalAnalysis)>),
     Simulation(Arc<Simulation>),
+}
+
+/// Where `Modes.shape` samples: a station of a beam or a point of a plate.
+enum ShapePoint {
+    Beam(BeamStation),
+    Plate(PlatePoint),
 }
 
 impl PyModes {
@@ -340,56 +337,47 @@ fn non_finite(file: &str, r: Result<(), flexcraft::finite::NonFinite>) -> Result
 #[pymethods]
 impl PyModes {
     /// The `modes --json` text (= modes.json).
-    fn json(&self) -> String {
-        output::modes_json(self.model(), self.modes())
+    fn json(&self) -> PyResult<String> {
+        guard(|| Ok(output::modes_json(self.model(), self.modes())))
     }
 
-    /// Arrays: frequency_hz, omega, rigid, number, mass_matrix, stiffness_matrix,
-    /// coefficients (modes × coordinates), effective_mass (hub-fixed modes × 6),
-    /// participation (hub-fixed modes × 6), hub_fixed_omega.
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        let m = &self.modes().modes;
-        d.set_item("omega", vec1(py, m.iter().map(|m| m.omega_rad_s).collect()))?;
-        d.set_item(
-            "frequency_hz",
-            vec1(py, m.iter().map(|m| m.frequency_hz()).collect()),
-        )?;
-        d.set_item(
-            "rigid",
-            m.iter()
-                .map(|m| m.rigid)
-                .collect::<Vec<bool>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item(
-            "number",
-            m.iter()
-                .map(|m| m.number as i64)
-                .collect::<Vec<i64>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item("mass_matrix", mat(py, &self.model().mass))?;
-        d.set_item("stiffness_matrix", mat(py, &self.model().stiffness))?;
-        let dof = self.model().dof();
-        d.set_item(
-            "coefficients",
-            Array2::from_shape_fn((m.len(), dof), |(i, j)| m[i].shape[j]).into_pyarray(py),
-        )?;
-        let hf = &self.modes().hub_fixed;
-        let em: Vec<[f64; 6]> = hf.iter().map(|h| h.effective_mass).collect();
-        let pa: Vec<[f64; 6]> = hf.iter().map(|h| h.participation).collect();
-        d.set_item("effective_mass", rows(py, &em))?;
-        d.set_item("participation", rows(py, &pa))?;
-        d.set_item(
-            "hub_fixed_omega",
-            vec1(py, hf.iter().map(|h| h.omega_rad_s).collect()),
-        )?;
-        d.set_item(
-            "appendage_mass",
-            vec1(py, self.modes().appendage_mass.to_vec()),
-        )?;
-        Ok(d)
+    /// One result as a NumPy array, made when Python first asks for it (the package caches
+    /// it): omega, frequency_hz, rigid, number, mass_matrix, stiffness_matrix, coefficients
+    /// (modes × coordinates), effective_mass and participation (hub-fixed modes × 6),
+    /// hub_fixed_omega, appendage_mass.
+    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let m = &self.modes().modes;
+            let hf = &self.modes().hub_fixed;
+            Ok(match name {
+                "omega" => vec1(py, m.iter().map(|m| m.omega_rad_s)),
+                "frequency_hz" => vec1(py, m.iter().map(|m| m.frequency_hz())),
+                "rigid" => m
+                    .iter()
+                    .map(|m| m.rigid)
+                    .collect::<Vec<bool>>()
+                    .into_pyarray(py)
+                    .into_any(),
+                "number" => m
+                    .iter()
+                    .map(|m| m.number as i64)
+                    .collect::<Vec<i64>>()
+                    .into_pyarray(py)
+                    .into_any(),
+                "mass_matrix" => mat(py, &self.model().mass),
+                "stiffness_matrix" => mat(py, &self.model().stiffness),
+                "coefficients" => {
+                    Array2::from_shape_fn((m.len(), self.model().dof()), |(i, j)| m[i].shape[j])
+                        .into_pyarray(py)
+                        .into_any()
+                }
+                "effective_mass" => rows(py, hf.iter().map(|h| h.effective_mass)),
+                "participation" => rows(py, hf.iter().map(|h| h.participation)),
+                "hub_fixed_omega" => vec1(py, hf.iter().map(|h| h.omega_rad_s)),
+                "appendage_mass" => vec1(py, self.modes().appendage_mass),
+                _ => return Err(no_field("modes", name)),
+            })
+        })
     }
 
     /// Displacement and small rotation [ux, uy, uz, rx, ry, rz] (structure frame, m and rad
@@ -402,90 +390,89 @@ impl PyModes {
         component: &str,
         points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let st = &self.model().structure;
-        let m = &self.modes().modes;
-        let beam = st.beams().iter().position(|b| b.name() == component);
-        let plate = st.plates().iter().position(|p| p.name() == component);
-        let samples: Vec<Vec<[f64; 6]>> = if let Some(b) = beam {
-            let xs: PyReadonlyArray1<f64> = points.extract().map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "shape: \"{component}\" is a beam: points is a 1-D float array of ξ = x/L"
-                ))
-            })?;
-            let xs = xs.as_slice()?.to_vec();
-            let stations = xs
-                .iter()
-                .map(|&xi| {
-                    if !(0.0..=1.0).contains(&xi) {
-                        return Err(PyValueError::new_err(format!(
-                            "shape: ξ = {xi} is outside [0, 1]"
-                        )));
-                    }
-                    BeamStation::new(self.model(), b, xi)
-                        .ok_or_else(|| PyValueError::new_err("shape: no such beam"))
-                })
-                .collect::<PyResult<Vec<_>>>()?;
-            m.iter()
-                .map(|mode| {
-                    let att = attachment_of(self.model(), ComponentId::Beam(b), &mode.shape)
-                        .unwrap_or_default();
-                    stations
-                        .iter()
-                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
-                        .collect()
-                })
-                .collect()
-        } else if let Some(p) = plate {
-            let xy: PyReadonlyArray2<f64> = points.extract().map_err(|_| {
-                PyTypeError::new_err(format!(
-                    "shape: \"{component}\" is a plate: points is an n × 2 float array of (ξ, η)"
-                ))
-            })?;
-            let xy = xy.as_array();
-            if xy.ncols() != 2 {
-                return Err(PyValueError::new_err(
-                    "shape: a plate's points are n × 2 (ξ, η)",
-                ));
+        guard(|| {
+            let model = self.model();
+            let st = &model.structure;
+            let beam = st.beams().iter().position(|b| b.name() == component);
+            let plate = st.plates().iter().position(|p| p.name() == component);
+            let (id, at): (ComponentId, Vec<ShapePoint>) = if let Some(b) = beam {
+                let xs: PyReadonlyArray1<f64> = points.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "shape: \"{component}\" is a beam: points is a 1-D float array of ξ = x/L"
+                    ))
+                })?;
+                let at = xs
+                    .as_slice()?
+                    .iter()
+                    .map(|&xi| {
+                        if !(0.0..=1.0).contains(&xi) {
+                            return Err(PyValueError::new_err(format!(
+                                "shape: ξ = {xi} is outside [0, 1]"
+                            )));
+                        }
+                        BeamStation::new(model, b, xi)
+                            .map(ShapePoint::Beam)
+                            .ok_or_else(|| PyValueError::new_err("shape: no such beam"))
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                (ComponentId::Beam(b), at)
+            } else if let Some(p) = plate {
+                let xy: PyReadonlyArray2<f64> = points.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "shape: \"{component}\" is a plate: points is an n × 2 float array of (ξ, η)"
+                    ))
+                })?;
+                let xy = xy.as_array();
+                if xy.ncols() != 2 {
+                    return Err(PyValueError::new_err(
+                        "shape: a plate's points are n × 2 (ξ, η)",
+                    ));
+                }
+                let at = xy
+                    .rows()
+                    .into_iter()
+                    .map(|r| {
+                        let (xi, eta) = (r[0], r[1]);
+                        if !(0.0..=1.0).contains(&xi) || !(0.0..=1.0).contains(&eta) {
+                            return Err(PyValueError::new_err(format!(
+                                "shape: (ξ, η) = ({xi}, {eta}) is outside [0, 1]²"
+                            )));
+                        }
+                        PlatePoint::new(model, p, xi, eta)
+                            .map(ShapePoint::Plate)
+                            .ok_or_else(|| PyValueError::new_err("shape: no such plate"))
+                    })
+                    .collect::<PyResult<Vec<_>>>()?;
+                (ComponentId::Plate(p), at)
+            } else {
+                let names: Vec<&str> = st
+                    .beams()
+                    .iter()
+                    .map(|b| b.name())
+                    .chain(st.plates().iter().map(|p| p.name()))
+                    .collect();
+                return Err(PyValueError::new_err(format!(
+                    "shape: no beam or plate is named {component:?} (the model has {names:?})"
+                )));
+            };
+            let m = &self.modes().modes;
+            let mut flat = Vec::with_capacity(m.len() * at.len() * 6);
+            for mode in m {
+                let q = &mode.shape;
+                let att = attachment_of(model, id, q).unwrap_or_default();
+                for point in &at {
+                    let p = match point {
+                        ShapePoint::Beam(s) => s.sample(model, q, att),
+                        ShapePoint::Plate(s) => s.sample(model, q, att),
+                    };
+                    let (d, r) = (p.displacement.0, p.rotation.0);
+                    flat.extend([d[0], d[1], d[2], r[0], r[1], r[2]]);
+                }
             }
-            let pts = xy
-                .rows()
-                .into_iter()
-                .map(|r| {
-                    let (xi, eta) = (r[0], r[1]);
-                    if !(0.0..=1.0).contains(&xi) || !(0.0..=1.0).contains(&eta) {
-                        return Err(PyValueError::new_err(format!(
-                            "shape: (ξ, η) = ({xi}, {eta}) is outside [0, 1]²"
-                        )));
-                    }
-                    PlatePoint::new(self.model(), p, xi, eta)
-                        .ok_or_else(|| PyValueError::new_err("shape: no such plate"))
-                })
-                .collect::<PyResult<Vec<_>>>()?;
-            m.iter()
-                .map(|mode| {
-                    let att = attachment_of(self.model(), ComponentId::Plate(p), &mode.shape)
-                        .unwrap_or_default();
-                    pts.iter()
-                        .map(|s| six(s.sample(self.model(), &mode.shape, att)))
-                        .collect()
-                })
-                .collect()
-        } else {
-            let names: Vec<&str> = st
-                .beams()
-                .iter()
-                .map(|b| b.name())
-                .chain(st.plates().iter().map(|p| p.name()))
-                .collect();
-            return Err(PyValueError::new_err(format!(
-                "shape: no beam or plate is named {component:?} (the model has {names:?})"
-            )));
-        };
-        let n = samples.first().map_or(0, Vec::len);
-        let flat: Vec<f64> = samples.iter().flatten().flatten().copied().collect();
-        let a = numpy::ndarray::Array3::from_shape_vec((m.len(), n, 6), flat)
-            .map_err(|e| InternalError::new_err(e.to_string()))?;
-        Ok(a.into_pyarray(py).into_any())
+            let a = numpy::ndarray::Array3::from_shape_vec((m.len(), at.len(), 6), flat)
+                .map_err(|e| InternalError::new_err(e.to_string()))?;
+            Ok(a.into_pyarray(py).into_any())
+        })
     }
 
     /// Writes what `flexcraft modes --out DIR` writes.
@@ -495,11 +482,6 @@ impl PyModes {
             output::write_modes(o, self.model(), self.modes())
         })
     }
-}
-
-fn six(p: flexcraft::ritz::shapes::PointSample) -> [f64; 6] {
-    let (d, r) = (p.displacement, p.rotation);
-    [d.0[0], d.0[1], d.0[2], r.0[0], r.0[1], r.0[2]]
 }
 
 /// Stages, writes and swaps in an output folder as the command line does.
@@ -595,46 +577,62 @@ impl PyDeployment {
 #[pymethods]
 impl PyDeployment {
     /// The `deploy --json` text (= events.json).
-    fn json(&self) -> String {
-        output::deploy_json(&self.scenario.name, self.d(), self.coupled(), self.result())
+    fn json(&self) -> PyResult<String> {
+        guard(|| {
+            Ok(output::deploy_json(
+                &self.scenario.name,
+                self.d(),
+                self.coupled(),
+                self.result(),
+            ))
+        })
     }
 
     /// deployment.csv's text.
-    fn csv(&self) -> String {
-        output::deployment_csv(self.coupled(), self.result())
+    fn csv(&self) -> PyResult<String> {
+        guard(|| Ok(output::deployment_csv(self.coupled(), self.result())))
     }
 
-    /// Arrays: t (samples), alpha and rate (samples × hinges), and the latches as dicts.
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        let s = &self.result().samples;
-        let n = self.coupled().panels();
-        d.set_item("t", vec1(py, s.iter().map(|s| s.t).collect()))?;
-        let grid = |f: &dyn Fn(&flexcraft::deploy::Sample, usize) -> f64| {
-            Array2::from_shape_fn((s.len(), n), |(k, i)| f(&s[k], i))
-        };
-        d.set_item("alpha", grid(&|s, i| s.alpha[i]).into_pyarray(py))?;
-        d.set_item("rate", grid(&|s, i| s.rate[i]).into_pyarray(py))?;
-        let latches = PyList::empty(py);
-        for e in &self.result().latches {
-            let l = PyDict::new(py);
-            l.set_item("time", e.time)?;
-            l.set_item("hinge", e.hinge)?;
-            l.set_item("locked", e.locked.clone())?;
-            l.set_item("angles", vec1(py, e.angles.clone()))?;
-            l.set_item("rates_before", vec1(py, e.rates_before.clone()))?;
-            l.set_item("rates_after", vec1(py, e.rates_after.clone()))?;
-            l.set_item("energy_before", e.energy_before)?;
-            l.set_item("energy_after", e.energy_after)?;
-            l.set_item("energy_lost", e.energy_before - e.energy_after)?;
-            let imp: Vec<[f64; 3]> = e.impulses.iter().map(|(p, m)| [p[0], p[1], *m]).collect();
-            l.set_item("hinge_impulses", rows(py, &imp))?;
-            latches.append(l)?;
-        }
-        d.set_item("latches", latches)?;
-        d.set_item("all_latched", self.result().all_latched)?;
-        d.set_item("final_time", self.result().final_time)?;
-        Ok(d)
+    /// One result, made when Python first asks for it (the package caches it): t
+    /// (samples), alpha and rate (samples × hinges), latches (a list of dicts, the fields
+    /// of `flexcraft.Latch`), all_latched, final_time.
+    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let r = self.result();
+            let s = &r.samples;
+            let grid = |f: &dyn Fn(&flexcraft::deploy::Sample, usize) -> f64| {
+                Array2::from_shape_fn((s.len(), self.coupled().panels()), |(k, i)| f(&s[k], i))
+                    .into_pyarray(py)
+                    .into_any()
+            };
+            Ok(match name {
+                "t" => vec1(py, s.iter().map(|s| s.t)),
+                "alpha" => grid(&|s, i| s.alpha[i]),
+                "rate" => grid(&|s, i| s.rate[i]),
+                "latches" => {
+                    let latches = PyList::empty(py);
+                    for e in &r.latches {
+                        let l = PyDict::new(py);
+                        l.set_item("time", e.time)?;
+                        l.set_item("hinge", e.hinge)?;
+                        l.set_item("locked", e.locked.clone())?;
+                        l.set_item("angles", vec1(py, e.angles.iter().copied()))?;
+                        l.set_item("rates_before", vec1(py, e.rates_before.iter().copied()))?;
+                        l.set_item("rates_after", vec1(py, e.rates_after.iter().copied()))?;
+                        l.set_item("energy_before", e.energy_before)?;
+                        l.set_item("energy_after", e.energy_after)?;
+                        l.set_item("energy_lost", e.energy_before - e.energy_after)?;
+                        let imp = e.impulses.iter().map(|(p, m)| [p[0], p[1], *m]);
+                        l.set_item("hinge_impulses", rows(py, imp))?;
+                        latches.append(l)?;
+                    }
+                    latches.into_any()
+                }
+                "all_latched" => r.all_latched.into_bound_py_any(py)?,
+                "final_time" => r.final_time.into_bound_py_any(py)?,
+                _ => return Err(no_field("deploy", name)),
+            })
+        })
     }
 
     /// Writes what `flexcraft deploy --out DIR` writes.
@@ -685,25 +683,29 @@ struct PySimulation {
 #[pymethods]
 impl PySimulation {
     /// The `simulate --json` text (= summary.json).
-    fn json(&self) -> String {
-        output::simulate_json(&self.scenario, &self.sim)
+    fn json(&self) -> PyResult<String> {
+        guard(|| Ok(output::simulate_json(&self.scenario, &self.sim)))
     }
 
     /// response.csv as (header names, samples × columns array); None without a response.
-    fn response<'py>(&self, py: Python<'py>) -> Option<(Vec<String>, Bound<'py, PyAny>)> {
-        let r = self.sim.response.as_ref()?;
-        let hist = &r.history;
-        // The columns of write_simulate's response.csv, in its order.
-        let header = output::response_header(r);
-        let (nc, nm) = (r.channels.len(), r.modal.modes.len());
-        let t_latch = r.handover.latch_time;
-        let a = Array2::from_shape_fn((hist.times.len(), 2 + nc + nm), |(k, j)| match j {
-            0 => t_latch + hist.times[k],
-            1 => hist.times[k],
-            j if j < 2 + nc => hist.values[(k, j - 2)],
-            j => hist.modal[(k, j - 2 - nc)],
-        });
-        Some((header, a.into_pyarray(py).into_any()))
+    fn response<'py>(&self, py: Python<'py>) -> PyResult<Option<(Vec<String>, Bound<'py, PyAny>)>> {
+        guard(|| {
+            let Some(r) = self.sim.response.as_ref() else {
+                return Ok(None);
+            };
+            let hist = &r.history;
+            // The columns of write_simulate's response.csv, in its order.
+            let header = output::response_header(r);
+            let (nc, nm) = (r.channels.len(), r.modal.modes.len());
+            let t_latch = r.handover.latch_time;
+            let a = Array2::from_shape_fn((hist.times.len(), 2 + nc + nm), |(k, j)| match j {
+                0 => t_latch + hist.times[k],
+                1 => hist.times[k],
+                j if j < 2 + nc => hist.values[(k, j - 2)],
+                j => hist.modal[(k, j - 2 - nc)],
+            });
+            Ok(Some((header, a.into_pyarray(py).into_any())))
+        })
     }
 
     /// The modes and the deployment of the run, as the handles of `fc.modes` and `fc.deploy`.
@@ -771,68 +773,63 @@ struct PyExport {
 #[pymethods]
 impl PyExport {
     /// The `export --json` text (= model.json).
-    fn json(&self) -> String {
+    fn json(&self) -> PyResult<String> {
         let st = &self.scenario.structure;
-        output::export_json(st, &self.modes, &self.ex, &self.scenario.export.transfers)
+        guard(|| {
+            Ok(output::export_json(
+                st,
+                &self.modes,
+                &self.ex,
+                &self.scenario.export.transfers,
+            ))
+        })
     }
 
-    /// The command's warnings (e.g. fewer modes than asked for).
-    fn warnings(&self) -> Vec<String> {
-        self.warnings.clone()
-    }
-
-    /// Arrays and names of the first- and second-order forms and the modal data.
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let d = PyDict::new(py);
-        let ex = &self.ex;
-        let ss = ex.first_order();
-        d.set_item("A", mat(py, &ss.a))?;
-        d.set_item("B", mat(py, &ss.b))?;
-        d.set_item("C", mat(py, &ss.c))?;
-        d.set_item("D", mat(py, &ss.d))?;
-        d.set_item("state_names", ss.state_names)?;
-        d.set_item("input_names", ex.input_names.clone())?;
-        d.set_item("output_names", ex.output_names.clone())?;
-        let n = ex.mode_count();
-        d.set_item("M2", mat(py, &Mat::<f64>::identity(n, n)))?;
-        d.set_item("C2", mat(py, &ex.damping()))?;
-        d.set_item("K2", mat(py, &ex.stiffness()))?;
-        d.set_item("B2", mat(py, &ex.b))?;
-        d.set_item("F", mat(py, &ex.f))?;
-        d.set_item("G", mat(py, &ex.g))?;
-        d.set_item(
-            "omega",
-            vec1(py, ex.modes.iter().map(|m| m.omega_rad_s).collect()),
-        )?;
-        d.set_item(
-            "damping_ratio",
-            vec1(py, ex.modes.iter().map(|m| m.damping_ratio).collect()),
-        )?;
-        d.set_item(
-            "rigid",
-            ex.modes
-                .iter()
-                .map(|m| m.rigid)
-                .collect::<Vec<bool>>()
-                .into_pyarray(py),
-        )?;
-        d.set_item("site_shapes", mat(py, &ex.site_shapes))?;
-        let sites: Vec<[f64; 3]> = ex.site_positions.iter().map(|p| p.0).collect();
-        d.set_item("site_positions", rows(py, &sites))?;
-        d.set_item("total_mass", ex.total_mass)?;
-        let c = ex.center_of_mass;
-        d.set_item("center_of_mass", vec1(py, c.0.to_vec()))?;
-        d.set_item("rigid_mass_reference", rows(py, &ex.rigid_mass_reference))?;
-        d.set_item("rigid_mass_cm", rows(py, &ex.rigid_mass_cm))?;
-        d.set_item("hub_fixed_omega", vec1(py, ex.hub_fixed_omega.clone()))?;
-        d.set_item("participation", mat(py, &ex.participation))?;
-        d.set_item("effective_mass", mat(py, &ex.effective_mass))?;
-        d.set_item(
-            "effective_mass_fraction",
-            mat(py, &ex.effective_mass_fraction),
-        )?;
-        d.set_item("appendage_mass", vec1(py, ex.appendage_mass.to_vec()))?;
-        Ok(d)
+    /// One result, made when Python first asks for it (the package caches it): the first
+    /// order A, B, C, D and the names of x, u, y; the second order M2, C2, K2, B2, F, G; the
+    /// kept modes' omega, damping_ratio, rigid; the hub-fixed and rigid-body data; warnings.
+    fn field<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| {
+            let ex = &self.ex;
+            let n = ex.mode_count();
+            Ok(match name {
+                "A" => mat(py, &ex.first_order().a),
+                "B" => mat(py, &ex.first_order().b),
+                "C" => mat(py, &ex.first_order().c),
+                "D" => mat(py, &ex.first_order().d),
+                "state_names" => ex.first_order().state_names.into_bound_py_any(py)?,
+                "input_names" => ex.input_names.as_slice().into_bound_py_any(py)?,
+                "output_names" => ex.output_names.as_slice().into_bound_py_any(py)?,
+                "M2" => mat(py, &Mat::<f64>::identity(n, n)),
+                "C2" => mat(py, &ex.damping()),
+                "K2" => mat(py, &ex.stiffness()),
+                "B2" => mat(py, &ex.b),
+                "F" => mat(py, &ex.f),
+                "G" => mat(py, &ex.g),
+                "omega" => vec1(py, ex.modes.iter().map(|m| m.omega_rad_s)),
+                "damping_ratio" => vec1(py, ex.modes.iter().map(|m| m.damping_ratio)),
+                "rigid" => ex
+                    .modes
+                    .iter()
+                    .map(|m| m.rigid)
+                    .collect::<Vec<bool>>()
+                    .into_pyarray(py)
+                    .into_any(),
+                "site_shapes" => mat(py, &ex.site_shapes),
+                "site_positions" => rows(py, ex.site_positions.iter().map(|p| p.0)),
+                "total_mass" => ex.total_mass.into_bound_py_any(py)?,
+                "center_of_mass" => vec1(py, ex.center_of_mass.0),
+                "rigid_mass_reference" => rows(py, ex.rigid_mass_reference),
+                "rigid_mass_cm" => rows(py, ex.rigid_mass_cm),
+                "hub_fixed_omega" => vec1(py, ex.hub_fixed_omega.iter().copied()),
+                "participation" => mat(py, &ex.participation),
+                "effective_mass" => mat(py, &ex.effective_mass),
+                "effective_mass_fraction" => mat(py, &ex.effective_mass_fraction),
+                "appendage_mass" => vec1(py, ex.appendage_mass),
+                "warnings" => self.warnings.as_slice().into_bound_py_any(py)?,
+                _ => return Err(no_field("export", name)),
+            })
+        })
     }
 
     /// Writes what `flexcraft export --out DIR` writes.
