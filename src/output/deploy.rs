@@ -179,9 +179,11 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
     let v = json!({
         "units": {
             "time": "s", "angles": "rad", "rates": "rad/s", "energy": "J (kinetic)",
-            "force": "N·s, linear impulse from the inboard body (hub or panel i−1) on panel i, deployment-plane axes [u along the wing's length axis, v along its normal]",
-            "moment": "N·m·s, angular impulse carried by the hinge",
-            "base_impulse": "impulse the base receives at the root hinge, hub axes: force N·s, moment about the hinge point N·m·s",
+            "hinge_impulses": "latches[].hinge_impulses: force N·s, the linear impulse from the inboard body (hub or panel i−1) on panel i, deployment-plane axes [u along the wing's length axis, v along its normal]; moment N·m·s, the angular impulse carried by the hinge",
+            "base_impulse": "latches[].base_impulse: the impulse the base receives at the root hinge, hub axes: force N·s, moment about the hinge point N·m·s",
+            "peak_hinge_reactions": "force N, moment N·m (magnitudes), with their times in s",
+            "peak_root_loads": "force N, moment N·m: the force a beam's parent exerts on it and the moment about its root point, hub axes",
+            "peak_latch_moments": "N·m",
         },
         "name": name,
         "plate": d.plate,

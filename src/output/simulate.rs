@@ -179,7 +179,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             "time": "s", "length": "m", "angle": "rad", "energy": "J (kinetic unless stated)",
             "linear_momentum": "N·s", "angular_momentum": "N·m·s, about the hub's centre of mass",
             "frequency": "Hz", "modal_velocity": "√kg·m/s (mass-normalised modes)",
-            "force": "N", "moment": "N·m",
+            "force": "N, except deployment.latches[].hinge_impulses and base_impulse: N·s", "moment": "N·m, except deployment.latches[].hinge_impulses and base_impulse: N·m·s",
             "root_loads": "the force a beam's parent exerts on it and the moment about its root point, hub axes",
             "latch_moment": "the latch's moment on its hinge angle (opening positive); in the response, the wing's moment across the hinge line less the hinge spring's at the latch angle",
             "axes": "structure frame (the hub's body axes at the final latch)",
