@@ -221,6 +221,11 @@ impl Scenario {
             // serde names a missing field only in its message; put it into the key when it
             // is there (the location is the enclosing table either way).
             let mut key = key_at(src, span.start);
+            // `[deployment] hub` is in the schema only to be refused with its own message:
+            // not a field to suggest.
+            if key.starts_with("deployment.") && msg.starts_with("unknown field") {
+                msg = msg.replace(", `hub`", "");
+            }
             if let Some(field) = msg
                 .strip_prefix("missing field `")
                 .and_then(|r| r.split('`').next())

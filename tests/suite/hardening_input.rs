@@ -510,6 +510,12 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
         let out = run(&sub, "deploy", src, &[]);
         assert_refused(&sub, &out, line_of(src, needle), key, reason);
     }
+    // A misspelt key is offered the keys that exist, not the gone `hub`.
+    let src = SEED.replacen("panels = 3", "panls = 3", 1);
+    let err = Scenario::from_toml_str(&src, "s.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("`panels`") && !err.contains("`hub`"), "{err}");
     // Above the base's count: clamped, with the warning.
     let sc = Scenario::from_toml_str(
         &SEED.replace("base_modes = 6", "base_modes = 500"),
