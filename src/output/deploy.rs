@@ -133,6 +133,9 @@ pub(crate) fn impulse_scales(e: &crate::deploy::LatchEvent) -> (f64, f64) {
 fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
     let base = match d.base {
         BaseKind::Rigid => "rigid".to_string(),
+        BaseKind::Flexible { .. } if c.base.ritz.dof() <= 6 => {
+            "rigid (flexible asked, but it has no elastic component)".to_string()
+        }
         BaseKind::Flexible { .. } => format!(
             "flexible, {} of {} hub-fixed modes",
             c.modes(),
@@ -276,22 +279,33 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
         }
     }
     for k in &r.captures {
+        let rates: Vec<String> = k.rates.iter().map(|v| format!("{v:.6}")).collect();
         let _ = writeln!(
             s,
-            "\ncapture of hinge {} by its compliant latch at t = {:.9} s (rates {:?} rad/s)",
-            k.hinge, k.time, k.rates
+            "\ncapture of hinge {} by its compliant latch at t = {:.9} s (rates [{}] rad/s)",
+            k.hinge,
+            k.time,
+            rates.join(", ")
         );
     }
-    let _ = writeln!(
-        s,
-        "\n{} at t = {:.9} s",
-        if r.all_latched {
-            "all hinges latched"
-        } else {
-            "NOT all hinges latched"
-        },
-        r.final_time
-    );
+    let verdict = if r.all_latched {
+        "all hinges latched"
+    } else {
+        "NOT all hinges latched"
+    };
+    match r.captures.last() {
+        // Compliant latches: the run goes on after the last capture while they settle.
+        Some(last) if r.all_latched => {
+            let _ = writeln!(
+                s,
+                "\nall hinges captured (the last at t = {:.9} s); the latches settled until t = {:.9} s",
+                last.time, r.final_time
+            );
+        }
+        _ => {
+            let _ = writeln!(s, "\n{verdict} at t = {:.9} s", r.final_time);
+        }
+    }
     if c.base.hub_motion == HubMotion::Free {
         let b = final_body(r);
         // Each quantity's components within rounding of its largest over the run read 0.
