@@ -356,7 +356,7 @@ fn csv_header(c: &Coupled) -> String {
             cols(format!("{q}{a} [{unit}]"));
         }
     }
-    (1..=c.modes()).for_each(|j| cols(format!("base_eta_{j} [kg^0.5·m]")));
+    (1..=c.modes()).for_each(|j| cols(format!("base_eta_{j} [√kg·m]")));
     for b in &c.base.beams {
         for a in ["u", "v", "w"] {
             cols(format!("{}_tip_{a} [m]", b.name));

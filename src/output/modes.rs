@@ -299,7 +299,7 @@ fn frequencies_csv(model: &RitzModel, modes: &ModalAnalysis) -> std::io::Result<
         }
         header.extend(names.iter().map(|n| format!("strain energy share {n} [-]")));
         for d in DIRECTIONS {
-            let unit = if d.starts_with('r') { "kg m^2" } else { "kg" };
+            let unit = if d.starts_with('r') { "kg·m²" } else { "kg" };
             header.push(format!("effective mass {d} [{unit}]"));
         }
         w.write_record(&header)?;

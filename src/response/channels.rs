@@ -153,7 +153,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
         ),
         (
             3,
-            "hub_rot_",
+            "hub_r",
             "hub rotation about ",
             "rad",
             ChannelKind::HubRotation,

@@ -393,7 +393,7 @@ fn deploy_writes_complete_reproducible_outputs_and_json_interface() {
         "hub_x [m]",
         "hub_ry [rad]",
         "hub_wz [rad/s]",
-        "base_eta_1 [kg^0.5·m]",
+        "base_eta_1 [√kg·m]",
         "mast_tip_w [m]",
         "mast_root_my [N·m]",
         "cable_torque_2 [N·m]",
