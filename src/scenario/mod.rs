@@ -135,24 +135,37 @@ pub const DEFAULT_PLATE_TERMS: (usize, usize) = (8, 6);
 
 /// The key on the line of `offset`, prefixed by the enclosing table header: a readable name
 /// for the place toml's own errors point at.
+/// The key path of a table header line: `[hub]` → `hub`; an element of an array of tables,
+/// `[[beams]]`, gets its 0-based index as in the value errors (`beams[1]`): the count of
+/// the same header up to `end`, the end of the header's line.
+fn table_path(src: &str, end: usize, header: &str) -> String {
+    let name = header.trim_matches(|c| c == '[' || c == ']').trim();
+    if !header.starts_with("[[") {
+        return name.to_string();
+    }
+    let same = |l: &str| {
+        let l = l.trim();
+        l.starts_with("[[") && l.trim_matches(|c| c == '[' || c == ']').trim() == name
+    };
+    let index = src[..end].lines().filter(|l| same(l)).count();
+    format!("{name}[{}]", index.saturating_sub(1))
+}
+
 fn key_at(src: &str, offset: usize) -> String {
     let offset = offset.min(src.len());
     let line_start = src[..offset].rfind('\n').map_or(0, |i| i + 1);
     let line_end = src[offset..].find('\n').map_or(src.len(), |i| offset + i);
     let line = &src[line_start..line_end];
+    let trimmed = line.trim();
+    if trimmed.starts_with('[') {
+        return table_path(src, line_end, trimmed);
+    }
     let header = src[..line_start]
         .lines()
         .rev()
         .map(str::trim)
         .find(|l| l.starts_with('['))
-        .map(|l| l.trim_matches(|c| c == '[' || c == ']').trim().to_string());
-    let trimmed = line.trim();
-    if trimmed.starts_with('[') {
-        return trimmed
-            .trim_matches(|c| c == '[' || c == ']')
-            .trim()
-            .to_string();
-    }
+        .map(|l| table_path(src, line_start, l));
     let key = line.split('=').next().unwrap_or("").trim().to_string();
     match (header, key.is_empty() || !line.contains('=')) {
         (Some(h), false) => format!("{h}.{key}"),

@@ -676,3 +676,24 @@ fn ritz_accuracy_keys_are_refused_with_location() {
         "already have 806 coordinates",
     );
 }
+
+/// Schema errors inside an array of tables name the element as the value errors do
+/// (0-based): a misspelt key in the second `[[beams]]` is `beams[1].…`.
+#[test]
+fn schema_errors_name_the_array_element_like_value_errors() {
+    let full = include_str!("../../examples/full.toml");
+    let second = full.match_indices("[[beams]]").nth(1).expect("two beams").0;
+    let at = second + full[second..].find("\nlength =").expect("a length") + 1;
+    let src = format!("{}lenth{}", &full[..at], &full[at + "length".len()..]);
+    let err = Scenario::from_toml_str(&src, "full.toml").unwrap_err();
+    assert_eq!(err.key, "beams[1].lenth", "{err}");
+    assert_eq!(err.location.line, line_of(&src, "lenth ="));
+    // And a value error in the same element uses the same form.
+    let src = format!(
+        "{}length = -1.0{}",
+        &full[..at],
+        &full[at + full[at..].find('\n').unwrap()..]
+    );
+    let err = Scenario::from_toml_str(&src, "full.toml").unwrap_err();
+    assert!(err.key.starts_with("beams[1]"), "{err}");
+}
