@@ -4,7 +4,7 @@
 //! examples/montecarlo.toml (rigid base). `cargo bench --bench montecarlo`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flexcraft::montecarlo::{output_names, run_one};
+use flexcraft::montecarlo::Runner;
 use flexcraft::Scenario;
 use std::time::Duration;
 
@@ -12,9 +12,9 @@ fn bench(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/montecarlo.toml");
     let s = Scenario::from_file(std::path::Path::new(path)).expect("example parses");
     let mc = s.montecarlo.clone().expect("[montecarlo]");
-    let names = output_names(&s.structure, s.deployment.as_ref().unwrap()).len();
     let mut g = c.benchmark_group("montecarlo");
     g.sample_size(20).measurement_time(Duration::from_secs(5));
+    let runner = Runner::new(&s, &mc);
     let mut i = 0;
     g.bench_function("overhead: draw, apply and validate", |b| {
         b.iter(|| {
@@ -25,7 +25,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("whole run (draw, apply, deploy, outputs)", |b| {
         b.iter(|| {
             i += 1;
-            run_one(&s, &mc, names, i)
+            runner.run(i)
         })
     });
     g.finish();
