@@ -14,6 +14,12 @@ use flexcraft::{ModalAnalysis, RitzModel, Scenario};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// mimalloc instead of the system allocator: the deployment's many short-lived small
+/// matrices made glibc's malloc and free about a fifth of a run (docs/montecarlo.md,
+/// "Speed"); the numbers do not change.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const UNITS: &str = "Units: SI throughout — lengths m, masses kg, inertias kg·m², moduli Pa, \
 frequencies Hz (and rad/s), angles rad.";
 
