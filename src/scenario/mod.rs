@@ -207,11 +207,12 @@ impl Scenario {
         // Two stages, so that the kind of a refusal never depends on toml's wording: text
         // that is not TOML at all is a syntax error; TOML that does not fit the schema (an
         // unknown, missing or mistyped key) is a schema error.
-        let kind = match src.parse::<toml::Table>() {
+        // (The second parse runs only for a refused text.)
+        let kind = || match src.parse::<toml::Table>() {
             Err(_) => ErrorKind::Syntax,
             Ok(_) => ErrorKind::Schema,
         };
-        let raw: RawScenario = toml::from_str(src).map_err(|e| toml_error(&cx, kind, &e))?;
+        let raw: RawScenario = toml::from_str(src).map_err(|e| toml_error(&cx, kind(), &e))?;
         build(&cx, raw)
     }
 }
