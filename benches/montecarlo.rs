@@ -1,6 +1,8 @@
 //! The per-run overhead of a Monte Carlo run (docs/montecarlo.md, "Speed"): applying the
 //! drawn values to the scenario text and validating it again (what every run does before its
-//! deployment) against the deployment run itself, for the seed deployment of
+//! deployment when a structure key is dispersed, as the wing's areal density is here), the
+//! same with the deployment keys alone (only `[deployment]` lowered again, the structure
+//! kept), against the deployment run itself, for the seed deployment of
 //! examples/montecarlo.toml (rigid base). `cargo bench --bench montecarlo`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -22,6 +24,19 @@ fn bench(c: &mut Criterion) {
             s.with_values(&mc.overrides(i)).expect("valid")
         })
     });
+    let mut dep = mc.clone();
+    dep.dispersions
+        .retain(|d| d.path.starts_with("deployment."));
+    let only = s.deployment_overrides().expect("[deployment]");
+    g.bench_function(
+        "overhead, deployment keys only: draw, lower [deployment] again",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                only.deployment(&s, &dep.overrides(i)).expect("valid")
+            })
+        },
+    );
     g.bench_function("whole run (draw, apply, deploy, outputs)", |b| {
         b.iter(|| {
             i += 1;

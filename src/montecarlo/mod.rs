@@ -640,14 +640,28 @@ pub struct Analysis {
     pub correlations: Vec<f64>,
 }
 
+/// The applied values of the runs, by parameter, with their ranks (computed once for every
+/// output's ranking).
+struct Columns {
+    values: Vec<Vec<f64>>,
+    ranks: Vec<Vec<f64>>,
+}
+
 /// Parameters ranked by |Spearman ρ| with `y`, largest first (NaN last; ties in path
 /// order), with their SRRCs and the R² of the rank regression.
-fn ranking(mc: &MonteCarlo, columns: &[Vec<f64>], y: &[f64]) -> Sensitivity {
-    let rr = stats::rank_regression(columns, y);
-    let mut ranking: Vec<Ranked> = (mc.dispersions.iter().zip(columns).zip(&rr.coefficients))
-        .map(|((d, x), srrc)| Ranked {
+fn ranking(mc: &MonteCarlo, columns: &Columns, y: &[f64]) -> Sensitivity {
+    let yr = stats::ranks(y);
+    let rr = if y.iter().any(|v| v.is_nan()) {
+        stats::rank_regression(&columns.values, y)
+    } else {
+        stats::regress_ranks(&columns.ranks, &yr)
+    };
+    let mut ranking: Vec<Ranked> = (mc.dispersions.iter().zip(&columns.ranks))
+        .zip(&rr.coefficients)
+        .map(|((d, xr), srrc)| Ranked {
             parameter: d.path.clone(),
-            spearman: stats::spearman(x, y),
+            // Spearman's ρ = Pearson of the ranks (NaN ranked last).
+            spearman: stats::pearson(xr, &yr),
             srrc: *srrc,
         })
         .collect();
@@ -663,7 +677,7 @@ fn ranking(mc: &MonteCarlo, columns: &[Vec<f64>], y: &[f64]) -> Sensitivity {
 }
 
 /// The verdict of one requirement over the values of its output.
-fn verdict(q: &Requirement, mc: &MonteCarlo, columns: &[Vec<f64>], values: &[f64]) -> Verdict {
+fn verdict(q: &Requirement, mc: &MonteCarlo, columns: &Columns, values: &[f64]) -> Verdict {
     let n = values.len() as u64;
     let fail: Vec<f64> = values
         .iter()
@@ -709,6 +723,10 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
     let applied: Vec<Vec<f64>> = (0..mc.dispersions.len())
         .map(|k| column(&|r| r.applied[k]))
         .collect();
+    let columns = Columns {
+        ranks: applied.iter().map(|x| stats::ranks(x)).collect(),
+        values: applied.clone(),
+    };
     let outs: Vec<Vec<f64>> = (0..names.len())
         .map(|k| column(&|r| r.outputs[k]))
         .collect();
@@ -731,7 +749,7 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
                 .iter()
                 .position(|n| *n == q.output)
                 .expect("validated");
-            verdict(q, mc, &applied, &outs[k])
+            verdict(q, mc, &columns, &outs[k])
         })
         .collect();
     Analysis {
@@ -744,12 +762,12 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
             .collect(),
         verdicts,
         sensitivity: (names.iter().zip(&outs))
-            .map(|(n, y)| (n.clone(), ranking(mc, &applied, y)))
+            .map(|(n, y)| (n.clone(), ranking(mc, &columns, y)))
             .collect(),
         correlations: (mc.correlations.iter())
             .map(|c| {
                 let (i, j) = c.keys();
-                stats::spearman(&applied[i], &applied[j])
+                stats::pearson(&columns.ranks[i], &columns.ranks[j])
             })
             .collect(),
     }

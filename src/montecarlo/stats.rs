@@ -155,26 +155,26 @@ fn standardised(v: &[f64]) -> Option<Vec<f64>> {
 /// values). With independent parameters the SRRCs tend to the Spearman correlations.
 pub fn rank_regression(xs: &[Vec<f64>], y: &[f64]) -> RankRegression {
     let keep: Vec<usize> = (0..y.len()).filter(|&r| !y[r].is_nan()).collect();
-    let n = keep.len();
-    let k = xs.len();
+    let pick = |v: &[f64]| -> Vec<f64> { keep.iter().map(|&r| v[r]).collect() };
+    let xr: Vec<Vec<f64>> = xs.iter().map(|x| ranks(&pick(x))).collect();
+    regress_ranks(&xr, &ranks(&pick(y)))
+}
+
+/// [`rank_regression`] from the ranks (of the same runs, none NaN).
+pub fn regress_ranks(xranks: &[Vec<f64>], yranks: &[f64]) -> RankRegression {
+    let n = yranks.len();
+    let k = xranks.len();
     let undetermined = RankRegression {
         coefficients: vec![f64::NAN; k],
         r2: f64::NAN,
         runs: n,
     };
-    let pick = |v: &[f64]| -> Vec<f64> {
-        if n == v.len() {
-            v.to_vec()
-        } else {
-            keep.iter().map(|&r| v[r]).collect()
-        }
-    };
-    let Some(ry) = standardised(&ranks(&pick(y))) else {
+    let Some(ry) = standardised(yranks) else {
         return undetermined;
     };
     // The non-constant parameters take part in the fit.
-    let cols: Vec<(usize, Vec<f64>)> = (xs.iter().enumerate())
-        .filter_map(|(j, x)| standardised(&ranks(&pick(x))).map(|z| (j, z)))
+    let cols: Vec<(usize, Vec<f64>)> = (xranks.iter().enumerate())
+        .filter_map(|(j, x)| standardised(x).map(|z| (j, z)))
         .collect();
     let m = cols.len();
     if m == 0 || n < m + 2 {
