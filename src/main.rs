@@ -14,6 +14,12 @@ use flexcraft::{ModalAnalysis, RitzModel, Scenario};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// mimalloc instead of the system allocator: the deployment's many short-lived small
+/// matrices made glibc's malloc and free about a fifth of a run (docs/montecarlo.md,
+/// "Speed"); the numbers do not change.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const UNITS: &str = "Units: SI throughout — lengths m, masses kg, inertias kg·m², moduli Pa, \
 frequencies Hz (and rad/s), angles rad.";
 
@@ -97,7 +103,6 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    keep_freed_memory();
     let cli = Cli::parse();
     let done = match cli.command {
         Command::Modes {
@@ -115,34 +120,6 @@ fn main() -> ExitCode {
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
 }
-
-/// Lets freed heap blocks be reused instead of returned to the kernel. glibc's malloc serves
-/// every block above 128 KiB by its own mmap and unmaps it when freed, and trims the heap's
-/// top beyond 128 KiB, so the model's matrices — megabytes each, built and dropped at every
-/// refinement level of the term selection and in every integration step's work arrays — are
-/// page-faulted in and zeroed by the kernel again at each use: 24 % of a `modes` run of
-/// `examples/composite.toml` (perf), 0.6 s → 0.5 s with the thresholds raised. A one-shot
-/// process keeps its peak heap anyway. Nothing computed changes (the same operations on the
-/// same values), only where the memory comes from. Not a crate: one libc call, glibc only.
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn keep_freed_memory() {
-    // mallopt(3) parameters, from glibc's <malloc.h>.
-    const M_TRIM_THRESHOLD: i32 = -1;
-    const M_MMAP_THRESHOLD: i32 = -3;
-    unsafe extern "C" {
-        fn mallopt(param: i32, value: i32) -> i32;
-    }
-    // SAFETY: mallopt only changes the allocator's thresholds; it is called before any other
-    // thread exists, and glibc's largest accepted mmap threshold is 32 MiB on 64-bit
-    // (HEAP_MAX_SIZE / 2); a refused value leaves the default in place.
-    unsafe {
-        mallopt(M_MMAP_THRESHOLD, 32 << 20);
-        mallopt(M_TRIM_THRESHOLD, 256 << 20);
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn keep_freed_memory() {}
 
 /// "4G", "512M", "1000000" → bytes (K, M, G, T are powers of 1024).
 fn parse_bytes(s: &str) -> Result<u64, String> {

@@ -194,7 +194,7 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
     let records = pool.install(|| run_many(&s, &mc, &indices, &|| progress.inc(1)));
     progress.finish_and_clear();
     let d = s.deployment.as_ref().expect("checked");
-    let names = output_names(&s.structure, d);
+    let names = output_names(&s.structure, d, mc.response);
     let margins = worst_margins(d.chain.hinges.len(), records.iter().map(|r| &r.margins));
     let info = ShardInfo {
         hash: output::fingerprint(s.source_text(), &mc),

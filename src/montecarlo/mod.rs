@@ -7,14 +7,20 @@
 //! its values, and so its outputs, do not depend on the thread count, the shard split or the
 //! order of the runs.
 
+pub mod copula;
 pub mod distributions;
 pub mod order;
 pub mod stats;
 
 use crate::deploy::coupled::Coupled;
-use crate::deploy::{simulate_coupled, Deployment, DeploymentResult};
-use crate::scenario::{OverrideValue, Scenario};
+use crate::deploy::{simulate_coupled, Deployment, DeploymentResult, LatchModel};
+use crate::response::channels::standard_channels;
+use crate::response::handover::hand_over_coupled;
+use crate::response::{Channel, ModalResponse, ResponseError};
+use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
+use crate::scenario::{DeploymentOverrides, OverrideValue, Scenario};
 use crate::structure::Structure;
+pub use copula::{Copula, CopulaError, Correlation};
 pub use distributions::{Distribution, DistributionError};
 use rand::SeedableRng;
 use rand_chacha::ChaCha20Rng;
@@ -46,11 +52,20 @@ pub struct Requirement {
     pub probability: f64,
     /// c, in (0, 1).
     pub confidence: f64,
+    /// A factor of safety (≥ 1) the output is multiplied by before it is compared with
+    /// `max` (a load × factor ≤ its allowable); `None`: the output as it is.
+    pub factor_of_safety: Option<f64>,
 }
 
 impl Requirement {
-    /// Whether a run's value meets the bounds (NaN never does).
+    /// The value compared with the bounds: the output times the factor of safety.
+    pub fn checked(&self, v: f64) -> f64 {
+        self.factor_of_safety.map_or(v, |f| v * f)
+    }
+
+    /// Whether a run's output meets the bounds once factored (NaN never does).
     pub fn met(&self, v: f64) -> bool {
+        let v = self.checked(v);
         !v.is_nan() && self.min.is_none_or(|m| v >= m) && self.max.is_none_or(|m| v <= m)
     }
 }
@@ -66,6 +81,12 @@ pub struct MonteCarlo {
     pub dispersions: Vec<Dispersion>,
     /// The requirements.
     pub requirements: Vec<Requirement>,
+    /// The correlated pairs (`[[montecarlo.correlations]]`), as given.
+    pub correlations: Vec<Correlation>,
+    /// Their Gaussian copula (`None` without pairs).
+    pub copula: Option<Copula>,
+    /// Per-run response outputs (`response = true`; the scenario has `[response]`).
+    pub response: bool,
 }
 
 /// Points of the torque-margin curve over the hinge travel (fractions 0, 1/20, …, 1).
@@ -121,13 +142,30 @@ pub struct RunRecord {
 
 impl MonteCarlo {
     /// The values of run i: ChaCha20 seeded with `seed`, stream i, one draw per dispersion in
-    /// order.
+    /// order — its value, or for a correlated dispersion a standard normal score, which the
+    /// copula then correlates and maps through the dispersion's inverse CDF
+    /// ([`copula`]). Without correlations every value is its distribution's own draw.
     pub fn draw(&self, i: u64) -> Vec<f64> {
         let mut rng = ChaCha20Rng::seed_from_u64(self.seed);
         rng.set_stream(i);
-        (self.dispersions.iter())
-            .map(|d| d.distribution.sample(&mut rng))
-            .collect()
+        let members = self.copula.as_ref().map_or(&[][..], |c| c.members());
+        let mut v: Vec<f64> = (self.dispersions.iter().enumerate())
+            .map(|(k, d)| {
+                if members.binary_search(&k).is_ok() {
+                    rand_distr::Distribution::sample(&rand_distr::StandardNormal, &mut rng)
+                } else {
+                    d.distribution.sample(&mut rng)
+                }
+            })
+            .collect();
+        if let Some(c) = &self.copula {
+            let mut z: Vec<f64> = members.iter().map(|&k| v[k]).collect();
+            c.correlate(&mut z);
+            for (&k, z) in members.iter().zip(z) {
+                v[k] = self.dispersions[k].distribution.from_normal_score(z);
+            }
+        }
+        v
     }
 
     /// The (path, value) overrides of run i.
@@ -152,10 +190,13 @@ impl MonteCarlo {
 /// `latch_time.H` (s; NaN when hinge H never latched), `all_latched` (1/0),
 /// `final_latch_time` (s; +∞ when not all latched), `swing_back` (1/0), `min_swing_angle`
 /// (rad; NaN without swing-back), `energy_lost.H` (J, kinetic energy lost at the latch
-/// event of hinge H), `peak_hinge_force.H` (N) and `peak_hinge_moment.H` (N·m),
+/// event of hinge H), `peak_hinge_force.H` (N) and `peak_hinge_moment.H` (N·m), with rigid
+/// latches `latch_impulse.H` (N·m·s) and with compliant ones `peak_latch_moment.H` (N·m),
 /// `peak_root_force.BEAM` (N) and `peak_root_moment.BEAM` (N·m), `hub_attitude_excursion`
-/// (rad) and `hub_position_excursion` (m).
-pub fn output_names(st: &Structure, d: &Deployment) -> Vec<String> {
+/// (rad) and `hub_position_excursion` (m); with `response`, the peak elastic tip deflections
+/// over the response, `peak_tip_deflection.BEAM.v`, `….BEAM.w` and
+/// `peak_tip_deflection.PLATE.minus`, `….PLATE.plus` (m).
+pub fn output_names(st: &Structure, d: &Deployment, response: bool) -> Vec<String> {
     let n = d.chain.hinges.len();
     let hinge = |stem: &'static str| (1..=n).map(move |h| format!("{stem}.{h}"));
     let mut v: Vec<String> = hinge("latch_time").collect();
@@ -171,11 +212,41 @@ pub fn output_names(st: &Structure, d: &Deployment) -> Vec<String> {
     v.extend(hinge("energy_lost"));
     v.extend(hinge("peak_hinge_force"));
     v.extend(hinge("peak_hinge_moment"));
+    v.extend(hinge(match d.latch {
+        LatchModel::Rigid => "latch_impulse",
+        LatchModel::Compliant { .. } => "peak_latch_moment",
+    }));
     for b in st.beams() {
         v.push(format!("peak_root_force.{}", b.name()));
         v.push(format!("peak_root_moment.{}", b.name()));
     }
     v.extend(["hub_attitude_excursion", "hub_position_excursion"].map(String::from));
+    if response {
+        v.extend(deflection_channels(st).into_iter().map(|(name, _)| name));
+    }
+    v
+}
+
+/// The response outputs: per beam its tip's v and w, per plate its two tip corners, as
+/// (output name, the name of `flexcraft simulate`'s response channel).
+fn deflection_channels(st: &Structure) -> Vec<(String, String)> {
+    let mut v = Vec::new();
+    for b in st.beams() {
+        for side in ["v", "w"] {
+            v.push((
+                format!("peak_tip_deflection.{}.{side}", b.name()),
+                format!("{}_tip_{side}", b.name()),
+            ));
+        }
+    }
+    for p in st.plates() {
+        for side in ["minus", "plus"] {
+            v.push((
+                format!("peak_tip_deflection.{}.{side}", p.name()),
+                format!("{}_tip_{side}", p.name()),
+            ));
+        }
+    }
     v
 }
 
@@ -197,7 +268,13 @@ fn latch_times(n: usize, r: &DeploymentResult) -> Vec<f64> {
     t
 }
 
-/// The outputs of one run ([`output_names`] order).
+/// The deployment outputs of one run ([`output_names`] order, without the response ones).
+///
+/// Latch loads: with rigid latches `latch_impulse.H` is the largest |angular impulse| hinge
+/// H carries at any latch event (N·m·s; the impact is instantaneous, so the impulse, not a
+/// moment, is its load); with compliant latches `peak_latch_moment.H` is the peak |moment|
+/// of the latch spring–damper on hinge H, tracked at every integration step (not only at the
+/// samples) with the run's peak tracker (NaN if never captured).
 pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult) -> Vec<f64> {
     let n = d.chain.hinges.len();
     let times = latch_times(n, r);
@@ -230,6 +307,26 @@ pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult
     }
     v.extend(force);
     v.extend(moment);
+    match d.latch {
+        LatchModel::Rigid => {
+            let mut impulse = vec![0.0_f64; n];
+            for e in &r.latches {
+                for (h, (_, m)) in e.impulses.iter().enumerate().take(n) {
+                    impulse[h] = impulse[h].max(m.abs());
+                }
+            }
+            v.extend(impulse);
+        }
+        LatchModel::Compliant { .. } => {
+            v.extend((0..n).map(|h| {
+                let captured = r.captures.iter().any(|k| k.hinge == h + 1);
+                match r.load_peaks.get(h) {
+                    Some(p) if captured => p.0,
+                    _ => f64::NAN,
+                }
+            }));
+        }
+    }
     let panels = c.panels();
     for b in st.beams() {
         let at = c.base.beams.iter().position(|x| x.name == b.name());
@@ -275,44 +372,170 @@ pub fn torque_margins(d: &Deployment) -> Vec<Vec<f64>> {
         .collect()
 }
 
-/// Runs run i of `mc` on `base`: applies its values, deploys, and collects the outputs.
-pub fn run_one(base: &Scenario, mc: &MonteCarlo, names: usize, i: u64) -> RunRecord {
-    let applied = mc.draw(i);
-    let values: Vec<(&str, OverrideValue)> = (mc.dispersions.iter().zip(&applied))
-        .map(|(d, v)| (d.path.as_str(), OverrideValue::Number(*v)))
-        .collect();
-    let empty = |status| RunRecord {
-        index: i,
-        status,
-        applied: applied.clone(),
-        outputs: vec![f64::NAN; names],
-        margins: Vec::new(),
-    };
-    let Ok(s) = base.with_values(&values) else {
-        return empty(RunStatus::Refused);
-    };
-    let Some(d) = s.deployment.as_ref() else {
-        return empty(RunStatus::Refused);
-    };
-    let Ok((c, r)) = simulate_coupled(&s.structure, d) else {
-        return empty(RunStatus::Failed);
-    };
-    let out = outputs(&s.structure, d, &c, &r);
-    if out.len() != names {
-        // A dispersion changed the number of hinges or beams: not comparable.
-        return empty(RunStatus::Refused);
+/// The modes of the deployed structure and the channels of the tip deflections, for the
+/// response outputs.
+struct ResponseModel {
+    model: RitzModel,
+    modes: ModalAnalysis,
+    channels: Vec<Channel>,
+}
+
+impl ResponseModel {
+    /// The model, modes and deflection channels of a scenario's structure, as `simulate`
+    /// computes them.
+    fn new(s: &Scenario) -> Result<Self, RitzError> {
+        let model = RitzModel::assemble(&s.structure);
+        let modes = ModalAnalysis::compute(&model)?.with_selection(s.term_selection.as_ref());
+        let all = standard_channels(&model);
+        let channels = deflection_channels(&s.structure)
+            .into_iter()
+            .map(|(_, c)| {
+                (all.iter().find(|a| a.name == c).cloned())
+                    .expect("a tip channel for every beam and plate")
+            })
+            .collect();
+        Ok(Self {
+            model,
+            modes,
+            channels,
+        })
     }
-    let complete = !(r.diverged() || r.step_limit_reached());
-    RunRecord {
-        index: i,
-        status: if complete {
-            RunStatus::Ok
-        } else {
-            RunStatus::Incomplete
-        },
-        applied,
-        outputs: out,
-        margins: torque_margins(d),
+
+    /// The peak |deflection| of every channel over the response after the deployment `r`
+    /// (hand-over at the final latch, exact modal superposition, the `[response]` samples);
+    /// NaN when not every hinge latched.
+    fn peaks(
+        &self,
+        s: &Scenario,
+        d: &Deployment,
+        c: &Coupled,
+        r: &DeploymentResult,
+    ) -> Result<Vec<f64>, ResponseError> {
+        let settings = &s.response;
+        let h = match hand_over_coupled(&self.model, &self.modes, d, c, r, settings.handover) {
+            Ok(h) => h,
+            Err(ResponseError::NotLatched { .. }) => {
+                return Ok(vec![f64::NAN; self.channels.len()])
+            }
+            Err(e) => return Err(e),
+        };
+        let modal = ModalResponse::with_initial(
+            &self.modes,
+            &h.modal_displacement,
+            &h.modal_velocity,
+            settings,
+        );
+        let history = modal.sample(&self.modes, &self.channels, settings);
+        Ok((0..self.channels.len())
+            .map(|k| history.peak(k).0)
+            .collect())
+    }
+}
+
+/// What every run of an analysis shares, prepared once: the count of outputs, the
+/// re-lowering of `[deployment]` alone when every dispersed key is a deployment key (the
+/// structure then cannot change, and a run does not parse and build it again), and with
+/// response outputs the modes of the deployed structure (computed once, used by every run
+/// whose structure is the base's).
+pub struct Runner<'a> {
+    base: &'a Scenario,
+    mc: &'a MonteCarlo,
+    names: usize,
+    deployment_only: Option<DeploymentOverrides>,
+    response: Option<Result<ResponseModel, RitzError>>,
+}
+
+impl<'a> Runner<'a> {
+    /// Prepares the runs of `mc` on `base` (a scenario with `[deployment]`).
+    pub fn new(base: &'a Scenario, mc: &'a MonteCarlo) -> Self {
+        let d = base
+            .deployment
+            .as_ref()
+            .expect("a Monte Carlo scenario has [deployment]");
+        let names = output_names(&base.structure, d, mc.response).len();
+        let deployment_only =
+            if Scenario::deployment_paths_only(mc.dispersions.iter().map(|d| d.path.as_str())) {
+                base.deployment_overrides()
+            } else {
+                None
+            };
+        Self {
+            base,
+            mc,
+            names,
+            deployment_only,
+            response: mc.response.then(|| ResponseModel::new(base)),
+        }
+    }
+
+    /// Run i: applies its values, deploys, and collects the outputs.
+    pub fn run(&self, i: u64) -> RunRecord {
+        let applied = self.mc.draw(i);
+        let values: Vec<(&str, OverrideValue)> = (self.mc.dispersions.iter().zip(&applied))
+            .map(|(d, v)| (d.path.as_str(), OverrideValue::Number(*v)))
+            .collect();
+        let empty = |status| RunRecord {
+            index: i,
+            status,
+            applied: applied.clone(),
+            outputs: vec![f64::NAN; self.names],
+            margins: Vec::new(),
+        };
+        // The run's scenario: the base with a new deployment, or the whole file again.
+        let whole;
+        let (s, d) = match &self.deployment_only {
+            Some(t) => match t.deployment(self.base, &values) {
+                Ok(d) => (self.base, d),
+                Err(_) => return empty(RunStatus::Refused),
+            },
+            None => match self.base.with_values(&values) {
+                Ok(s) => {
+                    whole = s;
+                    match whole.deployment.clone() {
+                        Some(d) => (&whole, d),
+                        None => return empty(RunStatus::Refused),
+                    }
+                }
+                Err(_) => return empty(RunStatus::Refused),
+            },
+        };
+        let Ok((c, r)) = simulate_coupled(&s.structure, &d) else {
+            return empty(RunStatus::Failed);
+        };
+        let mut out = outputs(&s.structure, &d, &c, &r);
+        if let Some(base_model) = &self.response {
+            let same = std::ptr::eq(s, self.base)
+                || (s.structure == self.base.structure
+                    && s.term_selection.is_none()
+                    && self.base.term_selection.is_none());
+            let own;
+            let model = if same {
+                base_model.as_ref().ok()
+            } else {
+                own = ResponseModel::new(s);
+                own.as_ref().ok()
+            };
+            let Some(peaks) = model.and_then(|m| m.peaks(s, &d, &c, &r).ok()) else {
+                return empty(RunStatus::Failed);
+            };
+            out.extend(peaks);
+        }
+        if out.len() != self.names {
+            // A dispersion changed the number of hinges or beams: not comparable.
+            return empty(RunStatus::Refused);
+        }
+        let complete = !(r.diverged() || r.step_limit_reached());
+        RunRecord {
+            index: i,
+            status: if complete {
+                RunStatus::Ok
+            } else {
+                RunStatus::Incomplete
+            },
+            applied,
+            outputs: out,
+            margins: torque_margins(&d),
+        }
     }
 }
 
@@ -324,15 +547,11 @@ pub fn run_many(
     indices: &[u64],
     on_done: &(dyn Fn() + Sync),
 ) -> Vec<RunRecord> {
-    let d = base
-        .deployment
-        .as_ref()
-        .expect("a Monte Carlo scenario has [deployment]");
-    let names = output_names(&base.structure, d).len();
+    let runner = Runner::new(base, mc);
     indices
         .par_iter()
         .map(|&i| {
-            let r = run_one(base, mc, names, i);
+            let r = runner.run(i);
             on_done();
             r
         })
@@ -372,11 +591,35 @@ pub struct Verdict {
     pub runs_needed: u64,
     /// Met: failures ≤ allowed.
     pub met: bool,
-    /// The one-sided p/c tolerance bound on the output from the runs, on the side of the
-    /// bound (upper for `max`, lower for `min`; `None` when too few runs).
+    /// The one-sided p/c tolerance bound on the compared value (the output times the factor
+    /// of safety, if any) from the runs, on the side of the bound (upper for `max`, lower
+    /// for `min`; `None` when too few runs).
     pub tolerance_bound: Option<f64>,
-    /// The dispersed parameters ranked by |Spearman ρ| with the failure indicator.
-    pub drivers: Vec<(String, f64)>,
+    /// The dispersed parameters ranked by |Spearman ρ| with the failure indicator, with
+    /// their SRRCs.
+    pub drivers: Sensitivity,
+}
+
+/// One parameter's sensitivity measures for one output.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ranked {
+    /// The dispersed parameter's path.
+    pub parameter: String,
+    /// Spearman's rank correlation with the output (NaN when either is constant).
+    pub spearman: f64,
+    /// Its standardised rank regression coefficient ([`stats::rank_regression`]).
+    pub srrc: f64,
+}
+
+/// The sensitivity of one output to the dispersed parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sensitivity {
+    /// The parameters, largest |Spearman ρ| first (NaN last; ties in path order).
+    pub ranking: Vec<Ranked>,
+    /// R² of the rank regression.
+    pub r2: f64,
+    /// Runs in the rank regression (those with a value).
+    pub runs: usize,
 }
 
 /// Everything summary.json reports.
@@ -390,25 +633,51 @@ pub struct Analysis {
     pub outputs: Vec<(String, Summary)>,
     /// Per requirement.
     pub verdicts: Vec<Verdict>,
-    /// Per output: the parameters ranked by |Spearman ρ| (NaN when either is constant,
-    /// ranked last).
-    pub sensitivity: Vec<(String, Vec<(String, f64)>)>,
+    /// Per output: its sensitivity to the parameters.
+    pub sensitivity: Vec<(String, Sensitivity)>,
+    /// Per correlated pair ([`MonteCarlo::correlations`]): the Spearman correlation of the
+    /// applied values (against (6/π) asin(ρ/2) expected).
+    pub correlations: Vec<f64>,
 }
 
-/// Parameters ranked by |ρ| with `y`, largest first (NaN last; ties in path order).
-fn ranking(mc: &MonteCarlo, columns: &[Vec<f64>], y: &[f64]) -> Vec<(String, f64)> {
-    let mut r: Vec<(String, f64)> = (mc.dispersions.iter().zip(columns))
-        .map(|(d, x)| (d.path.clone(), stats::spearman(x, y)))
+/// The applied values of the runs, by parameter, with their ranks (computed once for every
+/// output's ranking).
+struct Columns {
+    values: Vec<Vec<f64>>,
+    ranks: Vec<Vec<f64>>,
+}
+
+/// Parameters ranked by |Spearman ρ| with `y`, largest first (NaN last; ties in path
+/// order), with their SRRCs and the R² of the rank regression.
+fn ranking(mc: &MonteCarlo, columns: &Columns, y: &[f64]) -> Sensitivity {
+    let yr = stats::ranks(y);
+    let rr = if y.iter().any(|v| v.is_nan()) {
+        stats::rank_regression(&columns.values, y)
+    } else {
+        stats::regress_ranks(&columns.ranks, &yr)
+    };
+    let mut ranking: Vec<Ranked> = (mc.dispersions.iter().zip(&columns.ranks))
+        .zip(&rr.coefficients)
+        .map(|((d, xr), srrc)| Ranked {
+            parameter: d.path.clone(),
+            // Spearman's ρ = Pearson of the ranks (NaN ranked last).
+            spearman: stats::pearson(xr, &yr),
+            srrc: *srrc,
+        })
         .collect();
-    r.sort_by(|a, b| {
+    ranking.sort_by(|a, b| {
         let key = |v: f64| if v.is_nan() { -1.0 } else { v.abs() };
-        key(b.1).total_cmp(&key(a.1))
+        key(b.spearman).total_cmp(&key(a.spearman))
     });
-    r
+    Sensitivity {
+        ranking,
+        r2: rr.r2,
+        runs: rr.runs,
+    }
 }
 
 /// The verdict of one requirement over the values of its output.
-fn verdict(q: &Requirement, mc: &MonteCarlo, columns: &[Vec<f64>], values: &[f64]) -> Verdict {
+fn verdict(q: &Requirement, mc: &MonteCarlo, columns: &Columns, values: &[f64]) -> Verdict {
     let n = values.len() as u64;
     let fail: Vec<f64> = values
         .iter()
@@ -426,7 +695,7 @@ fn verdict(q: &Requirement, mc: &MonteCarlo, columns: &[Vec<f64>], values: &[f64
     let s = stats::sorted(
         &values
             .iter()
-            .map(|v| if v.is_nan() { worst } else { *v })
+            .map(|v| if v.is_nan() { worst } else { q.checked(*v) })
             .collect::<Vec<_>>(),
     );
     let tolerance_bound = allowed.map(|f| {
@@ -454,6 +723,10 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
     let applied: Vec<Vec<f64>> = (0..mc.dispersions.len())
         .map(|k| column(&|r| r.applied[k]))
         .collect();
+    let columns = Columns {
+        ranks: applied.iter().map(|x| stats::ranks(x)).collect(),
+        values: applied.clone(),
+    };
     let outs: Vec<Vec<f64>> = (0..names.len())
         .map(|k| column(&|r| r.outputs[k]))
         .collect();
@@ -476,7 +749,7 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
                 .iter()
                 .position(|n| *n == q.output)
                 .expect("validated");
-            verdict(q, mc, &applied, &outs[k])
+            verdict(q, mc, &columns, &outs[k])
         })
         .collect();
     Analysis {
@@ -489,7 +762,13 @@ pub fn analyse(mc: &MonteCarlo, names: &[String], records: &[RunRecord]) -> Anal
             .collect(),
         verdicts,
         sensitivity: (names.iter().zip(&outs))
-            .map(|(n, y)| (n.clone(), ranking(mc, &applied, y)))
+            .map(|(n, y)| (n.clone(), ranking(mc, &columns, y)))
+            .collect(),
+        correlations: (mc.correlations.iter())
+            .map(|c| {
+                let (i, j) = c.keys();
+                stats::pearson(&columns.ranks[i], &columns.ranks[j])
+            })
             .collect(),
     }
 }

@@ -1,5 +1,5 @@
 //! Sample statistics of the runs: moments, percentiles, the empirical CDF, Spearman's rank
-//! correlation and the Kolmogorov–Smirnov distance.
+//! correlation, standardised rank regression and the Kolmogorov–Smirnov distance.
 
 /// The percentiles reported for every output, %.
 pub const PERCENTILES: [f64; 7] = [1.0, 5.0, 10.0, 50.0, 90.0, 95.0, 99.0];
@@ -117,6 +117,117 @@ pub fn spearman(x: &[f64], y: &[f64]) -> f64 {
     pearson(&ranks(x), &ranks(y))
 }
 
+/// A standardised rank regression (Iman & Conover 1979, "The use of the rank transform in
+/// regression", Technometrics 21, 499–509; Saltelli et al., *Global Sensitivity Analysis:
+/// The Primer*, 2008, §1.2.5): the least-squares fit of the standardised ranks of the output
+/// on the standardised ranks of all parameters together.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RankRegression {
+    /// The standardised rank regression coefficient (SRRC) of each parameter, in the order
+    /// given (NaN for a constant parameter, and all NaN when the fit is undetermined: a
+    /// constant output, fewer runs than parameters + 2, or parameters whose ranks are
+    /// collinear).
+    pub coefficients: Vec<f64>,
+    /// R² of the rank model: the share of the variance of the output's ranks it explains
+    /// (near 1: the output is close to monotone and additive in the parameters, and the
+    /// SRRCs rank them; small: they do not, and neither ranking tells the whole story).
+    pub r2: f64,
+    /// The runs the fit used (those with a value: NaN outputs are left out).
+    pub runs: usize,
+}
+
+/// Standardised values (mean 0, population sd 1); `None` for a constant column.
+fn standardised(v: &[f64]) -> Option<Vec<f64>> {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let ss = v.iter().map(|x| (x - m).powi(2)).sum::<f64>();
+    if ss == 0.0 || !ss.is_finite() {
+        return None;
+    }
+    let sd = (ss / n).sqrt();
+    Some(v.iter().map(|x| (x - m) / sd).collect())
+}
+
+/// The SRRCs of the parameters `xs` (columns, one value per run) for the output `y`, and R².
+/// With every column standardised, the coefficients solve R_xx b = r_xy (R_xx the rank
+/// correlation matrix of the parameters, r_xy their rank correlations with the output), and
+/// R² = bᵀ r_xy. Runs whose output is NaN are left out (±∞ rank as the largest/smallest
+/// values). With independent parameters the SRRCs tend to the Spearman correlations.
+pub fn rank_regression(xs: &[Vec<f64>], y: &[f64]) -> RankRegression {
+    let keep: Vec<usize> = (0..y.len()).filter(|&r| !y[r].is_nan()).collect();
+    let pick = |v: &[f64]| -> Vec<f64> { keep.iter().map(|&r| v[r]).collect() };
+    let xr: Vec<Vec<f64>> = xs.iter().map(|x| ranks(&pick(x))).collect();
+    regress_ranks(&xr, &ranks(&pick(y)))
+}
+
+/// [`rank_regression`] from the ranks (of the same runs, none NaN).
+pub fn regress_ranks(xranks: &[Vec<f64>], yranks: &[f64]) -> RankRegression {
+    let n = yranks.len();
+    let k = xranks.len();
+    let undetermined = RankRegression {
+        coefficients: vec![f64::NAN; k],
+        r2: f64::NAN,
+        runs: n,
+    };
+    let Some(ry) = standardised(yranks) else {
+        return undetermined;
+    };
+    // The non-constant parameters take part in the fit.
+    let cols: Vec<(usize, Vec<f64>)> = (xranks.iter().enumerate())
+        .filter_map(|(j, x)| standardised(x).map(|z| (j, z)))
+        .collect();
+    let m = cols.len();
+    if m == 0 || n < m + 2 {
+        return undetermined;
+    }
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(p, q)| p * q).sum::<f64>() / n as f64;
+    let mut a = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..=i {
+            let v = if i == j {
+                1.0
+            } else {
+                dot(&cols[i].1, &cols[j].1)
+            };
+            a[i * m + j] = v;
+            a[j * m + i] = v;
+        }
+    }
+    let r: Vec<f64> = cols.iter().map(|(_, z)| dot(z, &ry)).collect();
+    // Cholesky of R_xx (symmetric positive definite unless the ranks are collinear).
+    let mut l = vec![0.0; m * m];
+    for i in 0..m {
+        for j in 0..=i {
+            let s: f64 = (0..j).map(|q| l[i * m + q] * l[j * m + q]).sum();
+            if i == j {
+                let d = a[i * m + i] - s;
+                if d <= 1e-12 {
+                    return undetermined;
+                }
+                l[i * m + i] = d.sqrt();
+            } else {
+                l[i * m + j] = (a[i * m + j] - s) / l[j * m + j];
+            }
+        }
+    }
+    let mut b = r.clone();
+    for i in 0..m {
+        b[i] = (b[i] - (0..i).map(|q| l[i * m + q] * b[q]).sum::<f64>()) / l[i * m + i];
+    }
+    for i in (0..m).rev() {
+        b[i] = (b[i] - ((i + 1)..m).map(|q| l[q * m + i] * b[q]).sum::<f64>()) / l[i * m + i];
+    }
+    let mut coefficients = vec![f64::NAN; k];
+    for ((j, _), bj) in cols.iter().zip(&b) {
+        coefficients[*j] = *bj;
+    }
+    RankRegression {
+        coefficients,
+        r2: b.iter().zip(&r).map(|(p, q)| p * q).sum(),
+        runs: n,
+    }
+}
+
 /// The Kolmogorov–Smirnov distance D = sup |F_n(x) − F(x)| of a sample against an exact
 /// CDF (evaluated on both sides of every step of F_n).
 pub fn ks_distance(sample: &[f64], cdf: impl Fn(f64) -> f64) -> f64 {
@@ -151,5 +262,29 @@ mod tests {
         assert!((spearman(&[1.0, 2.0, 3.0], &[1.0, 8.0, 27.0]) - 1.0).abs() < 1e-15);
         // 1.9495 at α = 0.001 (Smirnov's table).
         assert!((ks_critical(1, 0.001) - 1.9495).abs() < 1e-3);
+    }
+
+    #[test]
+    fn rank_regression_of_an_exactly_monotone_additive_output() {
+        // y = x1 + x2 on a grid where the ranks are the values: y's ranks are an exact
+        // linear function of them only when one parameter alone drives it.
+        let x1: Vec<f64> = (0..50).map(f64::from).collect();
+        let x2: Vec<f64> = (0..50).map(|i| f64::from((i * 7) % 50)).collect();
+        let r = rank_regression(
+            &[x1.clone(), x2.clone()],
+            &x1.iter().map(|v| v.exp()).collect::<Vec<_>>(),
+        );
+        assert!((r.coefficients[0] - 1.0).abs() < 1e-12, "{r:?}");
+        assert!(r.coefficients[1].abs() < 1e-12, "{r:?}");
+        assert!((r.r2 - 1.0).abs() < 1e-12);
+        // A constant parameter has no coefficient; NaN outputs are left out.
+        let mut y = x1.clone();
+        y[3] = f64::NAN;
+        let r = rank_regression(&[x1.clone(), vec![2.0; 50]], &y);
+        assert!(r.coefficients[1].is_nan() && (r.coefficients[0] - 1.0).abs() < 1e-12);
+        assert_eq!(r.runs, 49);
+        // Too few runs: undetermined.
+        let r = rank_regression(&[x1[..3].to_vec(), x2[..3].to_vec()], &x1[..3]);
+        assert!(r.r2.is_nan());
     }
 }

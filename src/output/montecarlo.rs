@@ -10,8 +10,8 @@
 use super::plot::{line_chart, Series};
 use super::{num, OutputDir, OutputError};
 use crate::montecarlo::{
-    analyse, output_names, worst_margins, Analysis, MonteCarlo, RunRecord, RunStatus, Summary,
-    MARGIN_POINTS,
+    analyse, output_names, worst_margins, Analysis, MonteCarlo, RunRecord, RunStatus, Sensitivity,
+    Summary, MARGIN_POINTS,
 };
 use crate::Scenario;
 use serde_json::{json, Value};
@@ -93,21 +93,33 @@ fn summary_json(s: &Summary) -> Value {
     })
 }
 
-fn ranked(r: &[(String, f64)]) -> Value {
-    Value::Array(
-        r.iter()
-            .map(|(p, rho)| json!({"parameter": p, "spearman": rho}))
-            .collect(),
-    )
+fn ranked(r: &Sensitivity) -> Value {
+    let params: Vec<Value> = (r.ranking.iter())
+        .map(|p| json!({"parameter": p.parameter, "spearman": p.spearman, "srrc": p.srrc}))
+        .collect();
+    json!({"rank_regression_r2": r.r2, "runs": r.runs, "parameters": params})
 }
 
 /// summary.json.
-pub fn summary(info: &ShardInfo, a: &Analysis, margins: &[Vec<f64>]) -> String {
+pub fn summary(info: &ShardInfo, mc: &MonteCarlo, a: &Analysis, margins: &[Vec<f64>]) -> String {
+    let correlations: Vec<Value> = (mc.correlations.iter().zip(&a.correlations))
+        .map(|(c, sampled)| {
+            let (i, j) = c.keys();
+            let rho = c.coefficient();
+            json!({
+                "keys": [mc.dispersions[i].path, mc.dispersions[j].path],
+                "coefficient": rho,
+                "spearman_expected": 6.0 / std::f64::consts::PI * (rho / 2.0).asin(),
+                "spearman_sampled": sampled,
+            })
+        })
+        .collect();
     let verdicts: Vec<Value> = (a.verdicts.iter())
         .map(|v| {
             let q = &v.requirement;
             json!({
                 "name": q.name, "output": q.output, "min": q.min, "max": q.max,
+                "factor_of_safety": q.factor_of_safety,
                 "probability": q.probability, "confidence": q.confidence,
                 "runs": v.runs, "failures": v.failures, "failures_allowed": v.allowed,
                 "runs_needed": v.runs_needed, "met": v.met,
@@ -134,11 +146,12 @@ pub fn summary(info: &ShardInfo, a: &Analysis, margins: &[Vec<f64>]) -> String {
         "applied": named(&a.applied),
         "outputs": named(&a.outputs),
         "sensitivity": a.sensitivity.iter().map(|(n, r)| (n.clone(), ranked(r))).collect::<serde_json::Map<_, _>>(),
+        "correlations": correlations,
         "torque_margin": worst,
         "notes": {
             "percentiles": "linear interpolation between order statistics (Hyndman & Fan type 7), over the finite values",
-            "verdict": "order statistics (Wilks): met when failures ≤ failures_allowed at probability and confidence; a refused or failed run is a failure",
-            "sensitivity": "Spearman rank correlation of each dispersed parameter with the output, largest |ρ| first",
+            "verdict": "order statistics (Wilks): met when failures ≤ failures_allowed at probability and confidence; a refused or failed run is a failure; with a factor_of_safety the output × factor is compared with max, and tolerance_bound is on that product",
+            "sensitivity": "per output: Spearman rank correlation (spearman) of each dispersed parameter with the output, largest |ρ| first, and the standardised rank regression coefficients (srrc) of the fit of the output's ranks on all parameters' ranks, with its R² (rank_regression_r2) over the runs with a value",
             "torque_margin": "static margin k(α_ref − α)/μ − 1 over the travel, worst case over the runs (null: no friction, unbounded)",
         },
     });
@@ -158,11 +171,24 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
             o.mean, o.sd, o.min, o.percentiles[3], o.percentiles[6], o.max
         );
     }
+    s += "\nsensitivity (strongest parameter by |Spearman ρ|; SRRC: standardised rank regression coefficient, R² of the rank model)\n";
+    for (n, r) in &a.sensitivity {
+        match r.ranking.first().filter(|p| p.spearman.is_finite()) {
+            Some(p) => {
+                s += &format!(
+                    "{n:<30} {:<34} ρ = {:>7.3}  SRRC = {:>7.3}  R² = {:.3}\n",
+                    p.parameter, p.spearman, p.srrc, r.r2
+                )
+            }
+            None => s += &format!("{n:<30} – (constant)\n"),
+        }
+    }
     for v in &a.verdicts {
         let q = &v.requirement;
         s += &format!(
-            "\nrequirement \"{}\" ({} {}{}, p = {}, c = {}): {} — {} failures in {} runs, {} allowed; {} runs would allow the observed failures\n",
+            "\nrequirement \"{}\" ({}{} {}{}, p = {}, c = {}): {} — {} failures in {} runs, {} allowed; {} runs would allow the observed failures\n",
             q.name,
+            q.factor_of_safety.map_or(String::new(), |f| format!("{f} × ")),
             q.output,
             q.min.map_or(String::new(), |m| format!("≥ {m} ")),
             q.max.map_or(String::new(), |m| format!("≤ {m}")),
@@ -174,8 +200,11 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
             v.allowed.map_or("none (too few runs)".to_string(), |f| f.to_string()),
             v.runs_needed,
         );
-        if let Some((p, rho)) = v.drivers.first().filter(|d| d.1.is_finite()) {
-            s += &format!("  strongest driver of failures: {p} (Spearman ρ = {rho:.3})\n");
+        if let Some(p) = v.drivers.ranking.first().filter(|d| d.spearman.is_finite()) {
+            s += &format!(
+                "  strongest driver of failures: {} (Spearman ρ = {:.3}, SRRC = {:.3})\n",
+                p.parameter, p.spearman, p.srrc
+            );
         }
     }
     s
@@ -221,11 +250,20 @@ pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
             (None, Some(hi)) => format!("≤ {hi}"),
             (None, None) => String::new(),
         };
-        let driver = v
-            .drivers
-            .first()
-            .filter(|d| d.1.is_finite())
-            .map_or(String::new(), |(p, r)| format!("{} (ρ = {r:.3})", esc(p)));
+        let bound = match q.factor_of_safety {
+            Some(f) => format!("{f} × output {bound}"),
+            None => bound,
+        };
+        let driver = (v.drivers.ranking.first())
+            .filter(|d| d.spearman.is_finite())
+            .map_or(String::new(), |p| {
+                format!(
+                    "{} (ρ = {:.3}, SRRC = {:.3})",
+                    esc(&p.parameter),
+                    p.spearman,
+                    p.srrc
+                )
+            });
         h += &format!(
             "<tr><td>{}</td><td>{}</td><td>{bound}</td><td>{} / {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{}\">{}</td><td>{driver}</td></tr>\n",
             esc(&q.name), esc(&q.output), q.probability, q.confidence, v.failures,
@@ -234,14 +272,24 @@ pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
             if v.met { "met" } else { "not" }, if v.met { "met" } else { "not met" },
         );
     }
-    h += "</table>\n<h2>Outputs</h2>\n<table><tr><th>output</th><th>mean</th><th>sd</th><th>min</th><th>p50</th><th>p99</th><th>max</th><th>strongest parameter</th></tr>\n";
+    h += "</table>\n<h2>Outputs</h2>\n<p>Strongest parameter: the largest |Spearman ρ|; SRRC: its standardised rank regression coefficient in the fit of the output's ranks on all parameters' ranks; R²: the share of the rank variance that fit explains (a small R² means the output is not monotone and additive in the parameters, and neither measure tells the whole story).</p>\n<table><tr><th>output</th><th>mean</th><th>sd</th><th>min</th><th>p50</th><th>p99</th><th>max</th><th>strongest parameter</th><th>ρ</th><th>SRRC</th><th>R²</th></tr>\n";
     for ((n, o), (_, rank)) in a.outputs.iter().zip(&a.sensitivity) {
-        let top = rank
-            .first()
-            .filter(|d| d.1.is_finite())
-            .map_or(String::new(), |(p, r)| format!("{} ({r:.3})", esc(p)));
+        let (top, rho, srrc) = (rank.ranking.first())
+            .filter(|d| d.spearman.is_finite())
+            .map_or((String::new(), String::new(), String::new()), |p| {
+                (
+                    esc(&p.parameter),
+                    format!("{:.3}", p.spearman),
+                    format!("{:.3}", p.srrc),
+                )
+            });
+        let r2 = if rank.r2.is_finite() {
+            format!("{:.3}", rank.r2)
+        } else {
+            "–".into()
+        };
         h += &format!(
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{top}</td></tr>\n",
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{top}</td><td>{rho}</td><td>{srrc}</td><td>{r2}</td></tr>\n",
             esc(n), sig(o.mean), sig(o.sd), sig(o.min), sig(o.percentiles[3]), sig(o.percentiles[6]), sig(o.max)
         );
     }
@@ -370,7 +418,7 @@ pub fn write_montecarlo(
         return Ok(None);
     }
     let a = analyse(mc, names, records);
-    dir.write("summary.json", summary(info, &a, margins))?;
+    dir.write("summary.json", summary(info, mc, &a, margins))?;
     let mut plotted: Vec<&str> = mc.requirements.iter().map(|q| q.output.as_str()).collect();
     plotted.push("final_latch_time");
     plotted.sort_unstable();
@@ -572,7 +620,7 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
             reason: "scenario.toml has no [deployment] and [montecarlo]".into(),
         });
     };
-    let names = output_names(&s.structure, d);
+    let names = output_names(&s.structure, d, mc.response);
     let first_info = read_info(first)?;
     mc.runs = first_info.runs;
     let mut seen = vec![false; first_info.shards as usize];

@@ -22,7 +22,7 @@ mod ritz;
 pub use budget::{default_memory_budget, format_bytes, Estimate, RunParts};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
 pub use error::{ErrorKind, Location, ScenarioError};
-pub use overrides::{apply_overrides, OverrideValue};
+pub use overrides::{apply_overrides, DeploymentOverrides, OverrideValue};
 
 use crate::deploy::Deployment;
 use crate::response::ResponseSettings;
@@ -220,39 +220,42 @@ impl Scenario {
         // Two stages, so that the kind of a refusal never depends on toml's wording: text
         // that is not TOML at all is a syntax error; TOML that does not fit the schema (an
         // unknown, missing or mistyped key) is a schema error.
-        let kind = match src.parse::<toml::Table>() {
+        // (The second parse runs only for a refused text.)
+        let kind = || match src.parse::<toml::Table>() {
             Err(_) => ErrorKind::Syntax,
             Ok(_) => ErrorKind::Schema,
         };
-        let raw: RawScenario = toml::from_str(src).map_err(|e| {
-            let span = e.span().unwrap_or(0..0);
-            let mut msg = e.message().trim().to_string();
-            if msg.is_empty() {
-                msg = "malformed TOML here (a control character or an unexpected character)"
-                    .to_string();
-            }
-            // serde names a missing field only in its message; put it into the key when it
-            // is there (the location is the enclosing table either way).
-            let mut key = key_at(src, span.start);
-            // `[deployment] hub` is in the schema only to be refused with its own message:
-            // not a field to suggest.
-            if key.starts_with("deployment.") && msg.starts_with("unknown field") {
-                msg = msg.replace(", `hub`", "");
-            }
-            if let Some(field) = msg
-                .strip_prefix("missing field `")
-                .and_then(|r| r.split('`').next())
-            {
-                key = if key == "(top level)" {
-                    field.to_string()
-                } else {
-                    format!("{key}.{field}")
-                };
-            }
-            cx.err(kind, span, key, msg)
-        })?;
+        let raw: RawScenario = toml::from_str(src).map_err(|e| toml_error(&cx, kind(), &e))?;
         build(&cx, raw)
     }
+}
+
+/// A refusal of toml's deserializer, located, with the key it points at.
+fn toml_error(cx: &Ctx, kind: ErrorKind, e: &toml::de::Error) -> ScenarioError {
+    let span = e.span().unwrap_or(0..0);
+    let mut msg = e.message().trim().to_string();
+    if msg.is_empty() {
+        msg = "malformed TOML here (a control character or an unexpected character)".to_string();
+    }
+    // serde names a missing field only in its message; put it into the key when it is there
+    // (the location is the enclosing table either way).
+    let mut key = key_at(cx.src, span.start);
+    // `[deployment] hub` is in the schema only to be refused with its own message: not a
+    // field to suggest.
+    if key.starts_with("deployment.") && msg.starts_with("unknown field") {
+        msg = msg.replace(", `hub`", "");
+    }
+    if let Some(field) = msg
+        .strip_prefix("missing field `")
+        .and_then(|r| r.split('`').next())
+    {
+        key = if key == "(top level)" {
+            field.to_string()
+        } else {
+            format!("{key}.{field}")
+        };
+    }
+    cx.err(kind, span, key, msg)
 }
 
 /// The scenario, section by section; each section's own module lowers it and the domain
@@ -333,7 +336,13 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         None => None,
     };
     let montecarlo = match &raw.montecarlo {
-        Some(m) => Some(montecarlo::lower(cx, m, &structure, deployment.as_ref())?),
+        Some(m) => Some(montecarlo::lower(
+            cx,
+            m,
+            &structure,
+            deployment.as_ref(),
+            raw.response.is_some(),
+        )?),
         None => None,
     };
     Ok(Scenario {

@@ -2,10 +2,13 @@
 //! the requirements on per-run outputs.
 
 use super::context::Ctx;
-use super::raw::{RawDispersion, RawMonteCarlo, RawRequirement, S};
+use super::raw::{RawCorrelation, RawDispersion, RawMonteCarlo, RawRequirement, S};
 use super::{ErrorKind, Location, Scenario, ScenarioError};
 use crate::deploy::Deployment;
-use crate::montecarlo::{output_names, Dispersion, Distribution, MonteCarlo, Requirement};
+use crate::montecarlo::{
+    output_names, Copula, CopulaError, Correlation, Dispersion, Distribution, MonteCarlo,
+    Requirement,
+};
 use crate::structure::Structure;
 
 /// Most runs one scenario may ask for.
@@ -145,6 +148,28 @@ fn lower_requirement(
             ));
         }
     }
+    let factor_of_safety = match &r.factor_of_safety {
+        None => None,
+        Some(f) => {
+            let x = *f.get_ref();
+            if !(x.is_finite() && x >= 1.0) {
+                return Err(cx.invalid(
+                    f.span(),
+                    key("factor_of_safety"),
+                    format!("must be a finite number ≥ 1 (it multiplies the output), got {x}"),
+                ));
+            }
+            if min.is_some() || max.is_none() {
+                return Err(cx.invalid(
+                    f.span(),
+                    key("factor_of_safety"),
+                    "applies to a max bound only (output × factor ≤ max, a load against its \
+                     allowable); give max without min",
+                ));
+            }
+            Some(x)
+        }
+    };
     Ok(Requirement {
         name: r.name.get_ref().clone(),
         output: r.output.get_ref().clone(),
@@ -152,15 +177,83 @@ fn lower_requirement(
         max: max.map(|v| *v.get_ref()),
         probability,
         confidence,
+        factor_of_safety,
     })
 }
 
-/// `[montecarlo]`. It needs `[deployment]` (the runs are deployments).
+/// `[[montecarlo.correlations]]`: the pairs (keys resolved to dispersion indices) and their
+/// copula; each refusal is located at the entry's `keys` or `coefficient`.
+fn lower_correlations(
+    cx: &Ctx,
+    raw: &[S<RawCorrelation>],
+    dispersions: &[Dispersion],
+) -> Result<(Vec<Correlation>, Option<Copula>), ScenarioError> {
+    if raw.is_empty() {
+        return Ok((Vec::new(), None));
+    }
+    let key = |i: usize, k: &str| format!("montecarlo.correlations[{i}].{k}");
+    let mut pairs = Vec::new();
+    for (i, c) in raw.iter().enumerate() {
+        let c = c.get_ref();
+        let names = c.keys.get_ref();
+        let [a, b] = names.as_slice() else {
+            return Err(cx.invalid(
+                c.keys.span(),
+                key(i, "keys"),
+                format!("must name exactly two dispersed keys, got {}", names.len()),
+            ));
+        };
+        let index = |n: &String| {
+            dispersions
+                .iter()
+                .position(|d| d.path == *n)
+                .ok_or_else(|| {
+                    let known: Vec<&str> = dispersions.iter().map(|d| d.path.as_str()).collect();
+                    cx.invalid(
+                        c.keys.span(),
+                        key(i, "keys"),
+                        format!(
+                            "\"{n}\" is not dispersed: a correlation pairs two keys of \
+                         [montecarlo.dispersions] ({})",
+                            if known.is_empty() {
+                                "none".to_string()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    )
+                })
+        };
+        let (ia, ib) = (index(a)?, index(b)?);
+        let pair = Correlation::new(ia, ib, *c.coefficient.get_ref()).map_err(|e| {
+            let (span, k) = match e {
+                CopulaError::Coefficient(_) => (c.coefficient.span(), "coefficient"),
+                _ => (c.keys.span(), "keys"),
+            };
+            cx.invalid(span, key(i, k), e.to_string())
+        })?;
+        pairs.push(pair);
+    }
+    let marginals: Vec<Distribution> = dispersions.iter().map(|d| d.distribution.clone()).collect();
+    let copula = Copula::new(&marginals, &pairs).map_err(|e| {
+        let c = raw[e.pair].get_ref();
+        let (span, k) = match e.error {
+            CopulaError::NotPositiveDefinite { .. } => (c.coefficient.span(), "coefficient"),
+            _ => (c.keys.span(), "keys"),
+        };
+        cx.invalid(span, key(e.pair, k), e.error.to_string())
+    })?;
+    Ok((pairs, Some(copula)))
+}
+
+/// `[montecarlo]`. It needs `[deployment]` (the runs are deployments), and `[response]`
+/// (`response_written`) when it asks for the per-run response outputs.
 pub(super) fn lower(
     cx: &Ctx,
     m: &S<RawMonteCarlo>,
     st: &Structure,
     d: Option<&Deployment>,
+    response_written: bool,
 ) -> Result<MonteCarlo, ScenarioError> {
     let r = m.get_ref();
     let Some(d) = d else {
@@ -204,7 +297,20 @@ pub(super) fn lower(
             })
         })
         .collect::<Result<Vec<_>, ScenarioError>>()?;
-    let outputs = output_names(st, d);
+    let (correlations, copula) = lower_correlations(cx, &r.correlations, &dispersions)?;
+    let response = match &r.response {
+        Some(v) if *v.get_ref() && !response_written => {
+            return Err(cx.missing(
+                v.span(),
+                "montecarlo.response",
+                "the per-run response outputs need a [response] section (its duration, \
+                 output_rate, modes and damping_ratio set the response of every run)",
+            ))
+        }
+        Some(v) => *v.get_ref(),
+        None => false,
+    };
+    let outputs = output_names(st, d, response);
     let requirements = (r.requirements.iter().enumerate())
         .map(|(i, q)| lower_requirement(cx, i, q, &outputs))
         .collect::<Result<Vec<_>, _>>()?;
@@ -213,6 +319,9 @@ pub(super) fn lower(
         seed,
         dispersions,
         requirements,
+        correlations,
+        copula,
+        response,
     })
 }
 

@@ -209,6 +209,79 @@ impl Scenario {
     }
 }
 
+/// `[deployment]` alone, ready to take values at `deployment.…` paths and be lowered again
+/// against the structure of the scenario it came from: what a dispersion run needs when
+/// every dispersed key is a deployment key (the structure, and so its modes, cannot change
+/// then: the structure is built from the other sections only). The text is the section as
+/// the file writes it (comments kept), so a value meets exactly the checks
+/// [`Scenario::with_values`] applies; only the location of a refusal differs (it points into
+/// this text).
+#[derive(Debug, Clone)]
+pub struct DeploymentOverrides {
+    text: String,
+    file: String,
+}
+
+/// The first segment of the paths [`DeploymentOverrides`] takes.
+const DEPLOYMENT: &str = "deployment";
+
+impl Scenario {
+    /// `[deployment]` alone for [`DeploymentOverrides::deployment`]; `None` without the
+    /// section.
+    pub fn deployment_overrides(&self) -> Option<DeploymentOverrides> {
+        let doc: DocumentMut = self.source_text().parse().ok()?;
+        let item = doc.get(DEPLOYMENT)?.clone();
+        let mut only = DocumentMut::new();
+        only.insert(DEPLOYMENT, item);
+        Some(DeploymentOverrides {
+            text: only.to_string(),
+            file: format!("{} ([deployment] with overrides)", self.sources.file),
+        })
+    }
+
+    /// Whether every path is a `deployment.…` path (then [`DeploymentOverrides`] applies).
+    pub fn deployment_paths_only<'a>(paths: impl IntoIterator<Item = &'a str>) -> bool {
+        paths
+            .into_iter()
+            .all(|p| p.split('.').next() == Some(DEPLOYMENT) && p.len() > DEPLOYMENT.len())
+    }
+}
+
+impl DeploymentOverrides {
+    /// The deployment of `base` (the scenario this came from) with values at `deployment.…`
+    /// paths, validated like a file: the same as `base.with_values(values)?.deployment`.
+    pub fn deployment(
+        &self,
+        base: &Scenario,
+        values: &[(&str, OverrideValue)],
+    ) -> Result<crate::deploy::Deployment, ScenarioError> {
+        let refuse = |key: String, reason: String| ScenarioError {
+            kind: ErrorKind::Invalid,
+            file: self.file.clone(),
+            location: Location { line: 0, column: 0 },
+            key,
+            reason,
+        };
+        if let Some((p, _)) = values
+            .iter()
+            .find(|(p, _)| !Scenario::deployment_paths_only([*p]))
+        {
+            return Err(refuse(
+                p.to_string(),
+                "not a deployment key: use Scenario::with_values".into(),
+            ));
+        }
+        let text = apply_overrides(&self.text, values).map_err(|(p, why)| refuse(p, why))?;
+        let cx = super::context::Ctx {
+            src: &text,
+            file: &self.file,
+        };
+        let raw: super::raw::RawDeploymentOnly =
+            toml::from_str(&text).map_err(|e| super::toml_error(&cx, ErrorKind::Schema, &e))?;
+        super::deployment::lower(&cx, &raw.deployment, &base.structure)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -253,6 +326,45 @@ mod tests {
             .with_values(&[("deployment.panels", 2.5.into())])
             .unwrap_err();
         assert!(e.reason.contains("integer"), "{e}");
+    }
+
+    #[test]
+    fn deployment_overrides_lower_as_the_whole_file_does() {
+        let s = seed();
+        let t = s.deployment_overrides().expect("the seed deploys");
+        for values in [
+            vec![("deployment.hinge.stiffness", OverrideValue::Number(1.5))],
+            vec![
+                ("deployment.hinge.friction", OverrideValue::Number(0.002)),
+                ("deployment.hinge.preload_angle", OverrideValue::Number(0.3)),
+                ("deployment.end_time", OverrideValue::Number(50.0)),
+            ],
+            vec![("deployment.panels", OverrideValue::Number(2.0))],
+        ] {
+            let whole = s.with_values(&values).unwrap().deployment.unwrap();
+            assert_eq!(t.deployment(&s, &values).unwrap(), whole);
+        }
+        // Refusals are the same refusals (key and reason).
+        for values in [
+            vec![("deployment.hinge.stiffness", OverrideValue::Number(-1.0))],
+            vec![("deployment.panels", OverrideValue::Number(2.5))],
+            vec![("deployment.hinge.stifness", OverrideValue::Number(1.0))],
+        ] {
+            let a = s.with_values(&values).unwrap_err();
+            let b = t.deployment(&s, &values).unwrap_err();
+            assert_eq!((a.key, a.reason), (b.key, b.reason), "{values:?}");
+        }
+        assert!(t
+            .deployment(&s, &[("hub.mass", OverrideValue::Number(1.0))])
+            .is_err());
+        assert!(Scenario::deployment_paths_only([
+            "deployment.hinge.stiffness"
+        ]));
+        assert!(!Scenario::deployment_paths_only([
+            "deployments.x",
+            "deployment.a"
+        ]));
+        assert!(!Scenario::deployment_paths_only(["deployment"]));
     }
 
     #[test]

@@ -29,6 +29,14 @@ pub struct RawScenario {
     pub montecarlo: Option<S<RawMonteCarlo>>,
 }
 
+/// A document holding `[deployment]` alone (the re-lowering of dispersed deployment keys:
+/// [`super::DeploymentOverrides`]).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawDeploymentOnly {
+    pub deployment: S<RawDeployment>,
+}
+
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum RawMotion {
@@ -327,6 +335,17 @@ pub struct RawMonteCarlo {
     pub dispersions: BTreeMap<String, S<RawDispersion>>,
     #[serde(default)]
     pub requirements: Vec<S<RawRequirement>>,
+    #[serde(default)]
+    pub correlations: Vec<S<RawCorrelation>>,
+    /// Per-run response outputs (needs `[response]`).
+    pub response: Option<S<bool>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCorrelation {
+    pub keys: S<Vec<String>>,
+    pub coefficient: S<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -349,4 +368,5 @@ pub struct RawRequirement {
     pub max: Option<S<f64>>,
     pub probability: S<f64>,
     pub confidence: S<f64>,
+    pub factor_of_safety: Option<S<f64>>,
 }

@@ -5,8 +5,10 @@
 
 use super::common::{bin, scratch};
 use flexcraft::deploy::simulate_coupled;
-use flexcraft::montecarlo::stats::{ks_critical, ks_distance};
-use flexcraft::montecarlo::{order, output_names, outputs, run_many, Distribution};
+use flexcraft::montecarlo::stats::{ks_critical, ks_distance, pearson, rank_regression, spearman};
+use flexcraft::montecarlo::{
+    analyse, order, output_names, outputs, run_many, Distribution, RunRecord, RunStatus,
+};
 use flexcraft::Scenario;
 use std::path::Path;
 
@@ -75,7 +77,7 @@ fn latch_time_cdf_matches(runs: u64) {
     let cdf = |x: f64| 1.0 - exact.cdf(j * a * a / (x * x));
     let indices: Vec<u64> = (0..runs).collect();
     let records = run_many(&s, &mc, &indices, &|| ());
-    let names = output_names(&s.structure, d);
+    let names = output_names(&s.structure, d, false);
     let k = names.iter().position(|n| n == "latch_time.1").unwrap();
     let t: Vec<f64> = records.iter().map(|r| r.outputs[k]).collect();
     assert!(t.iter().all(|x| x.is_finite()));
@@ -251,6 +253,9 @@ seed = {seed}
 "deployment.hinge.stiffness" = {{ normal = [3.0, 0.3] }}
 "deployment.hinge.friction" = {{ uniform = [0.0, 0.02] }}
 "plates.wing.areal_density" = {{ normal = [5.0, 0.2], truncate = [4.6, 5.4] }}
+[[montecarlo.correlations]]
+keys = ["deployment.hinge.stiffness", "plates.wing.areal_density"]
+coefficient = 0.5
 [[montecarlo.requirements]]
 name = "latched within 1.3 s"
 output = "final_latch_time"
@@ -416,7 +421,7 @@ fn prop_runs_rerun_from_their_written_scenarios_give_the_same_outputs_bit_for_bi
         let d = s.deployment.as_ref().unwrap();
         let (c, r) = simulate_coupled(&s.structure, d).unwrap();
         let out = outputs(&s.structure, d, &c, &r);
-        let names = output_names(&s.structure, d);
+        let names = output_names(&s.structure, d, false);
         let row = &table[i];
         assert_eq!(row[0], i.to_string());
         for (name, v) in names.iter().zip(&out) {
@@ -493,8 +498,9 @@ fn prop_bad_input_is_located_and_refused_with_nothing_written() {
             "frction",
         ),
         (
+            // (in the correlation too, which must name a dispersed key)
             "unknown_component",
-            swap(
+            base.replace(
                 "\"plates.wing.areal_density\"",
                 "\"plates.wong.areal_density\"",
             ),
@@ -557,6 +563,109 @@ fn prop_bad_input_is_located_and_refused_with_nothing_written() {
             "runs = 0",
             "montecarlo.runs",
             "from 1 to",
+        ),
+        (
+            "correlation_coefficient",
+            swap("coefficient = 0.5", "coefficient = 1.0"),
+            "coefficient = 1.0",
+            "montecarlo.correlations[0].coefficient",
+            "strictly between −1 and 1",
+        ),
+        (
+            "correlation_not_dispersed",
+            swap(
+                "\"plates.wing.areal_density\"]",
+                "\"deployment.hinge.damping\"]",
+            ),
+            "keys = [",
+            "montecarlo.correlations[0].keys",
+            "is not dispersed",
+        ),
+        (
+            "correlation_same_key",
+            swap(
+                "\"plates.wing.areal_density\"]",
+                "\"deployment.hinge.stiffness\"]",
+            ),
+            "keys = [",
+            "montecarlo.correlations[0].keys",
+            "the same key twice",
+        ),
+        (
+            "correlation_three_keys",
+            swap(
+                "\"plates.wing.areal_density\"]",
+                "\"plates.wing.areal_density\", \"deployment.hinge.friction\"]",
+            ),
+            "keys = [",
+            "montecarlo.correlations[0].keys",
+            "exactly two",
+        ),
+        (
+            "correlation_discrete",
+            swap("uniform = [0.0, 0.02]", "choice = [0.0, 0.01]").replacen(
+                "\"plates.wing.areal_density\"]",
+                "\"deployment.hinge.friction\"]",
+                1,
+            ),
+            "keys = [",
+            "montecarlo.correlations[0].keys",
+            "discrete choice cannot be correlated",
+        ),
+        (
+            "correlation_twice",
+            swap(
+                "coefficient = 0.5\n",
+                "coefficient = 0.5\n[[montecarlo.correlations]]\n\
+                 keys = [\"plates.wing.areal_density\", \"deployment.hinge.stiffness\"]\n\
+                 coefficient = 0.2\n",
+            ),
+            "keys = [\"plates.wing.areal_density\"",
+            "montecarlo.correlations[1].keys",
+            "already correlated by correlations[0]",
+        ),
+        (
+            // ρ(k, ρA) = 0.5 and ρ(k, μ) = 0.8 are a correlation matrix (ρ(ρA, μ) = 0);
+            // ρ(ρA, μ) = −0.8 makes it indefinite: refused at that pair.
+            "correlation_not_positive_definite",
+            swap(
+                "coefficient = 0.5\n",
+                "coefficient = 0.5\n[[montecarlo.correlations]]\n\
+                 keys = [\"deployment.hinge.stiffness\", \"deployment.hinge.friction\"]\n\
+                 coefficient = 0.8\n[[montecarlo.correlations]]\n\
+                 keys = [\"plates.wing.areal_density\", \"deployment.hinge.friction\"]\n\
+                 coefficient = -0.8\n",
+            ),
+            "coefficient = -0.8",
+            "montecarlo.correlations[2].coefficient",
+            "not positive definite",
+        ),
+        (
+            "factor_of_safety_below_one",
+            swap(
+                "confidence = 0.9\n",
+                "confidence = 0.9\nfactor_of_safety = 0.8\n",
+            ),
+            "factor_of_safety = 0.8",
+            "montecarlo.requirements[0].factor_of_safety",
+            "≥ 1",
+        ),
+        (
+            "factor_of_safety_with_min",
+            swap(
+                "max = 1.3\n",
+                "min = 0.1\nmax = 1.3\nfactor_of_safety = 2.0\n",
+            ),
+            "factor_of_safety = 2.0",
+            "montecarlo.requirements[0].factor_of_safety",
+            "applies to a max bound only",
+        ),
+        (
+            "response_without_response_section",
+            swap("seed = 1\n", "seed = 1\nresponse = true\n"),
+            "response = true",
+            "montecarlo.response",
+            "need a [response] section",
         ),
         (
             // Every hinge sets its own stiffness: [deployment.hinge] stiffness is unused.
@@ -640,4 +749,409 @@ fn prop_bad_input_is_located_and_refused_with_nothing_written() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing"));
     assert!(!m.exists());
+}
+
+/// Spearman's ρ_S of a bivariate normal with correlation ρ: (6/π) asin(ρ/2) (Pearson 1907;
+/// Kruskal 1958, JASA 53, 814–861, eq. 5.3).
+fn spearman_of_normal(rho: f64) -> f64 {
+    6.0 / std::f64::consts::PI * (rho / 2.0).asin()
+}
+
+/// The standard error of a sample Spearman correlation near ρ_S from n values (Fieller,
+/// Hartley & Pearson 1957: var(artanh r_S) ≈ 1.06/(n − 3)).
+fn spearman_se(rho_s: f64, n: usize) -> f64 {
+    (1.0 - rho_s * rho_s) * (1.06 / (n as f64 - 3.0)).sqrt()
+}
+
+#[test]
+fn val_correlated_pairs_follow_the_gaussian_copula() {
+    let src = one_panel(
+        r#"[montecarlo]
+runs = 10
+seed = 2026
+[montecarlo.dispersions]
+"deployment.hinge.stiffness" = { normal = [3.0, 0.2] }
+"deployment.hinge.damping" = { normal = [0.05, 0.01] }
+"deployment.hinge.friction" = { uniform = [0.0, 0.01] }
+"plates.wing.areal_density" = { lognormal = [1.6, 0.1] }
+"deployment.hinge.preload_angle" = { normal = [0.4, 0.05], truncate = [0.35, 0.48] }
+[[montecarlo.correlations]]
+keys = ["deployment.hinge.stiffness", "deployment.hinge.damping"]
+coefficient = 0.6
+[[montecarlo.correlations]]
+keys = ["deployment.hinge.friction", "deployment.hinge.stiffness"]
+coefficient = -0.5
+[[montecarlo.correlations]]
+keys = ["plates.wing.areal_density", "deployment.hinge.preload_angle"]
+coefficient = 0.7
+"#,
+    );
+    let s = parse(&src);
+    s.check_dispersions().unwrap();
+    let mc = s.montecarlo.clone().unwrap();
+    let n = 200_000usize;
+    let draws: Vec<Vec<f64>> = (0..n as u64).map(|i| mc.draw(i)).collect();
+    let col = |p: &str| -> Vec<f64> {
+        let k = mc.dispersions.iter().position(|d| d.path == p).unwrap();
+        draws.iter().map(|v| v[k]).collect()
+    };
+    let (k, c, mu) = (
+        col("deployment.hinge.stiffness"),
+        col("deployment.hinge.damping"),
+        col("deployment.hinge.friction"),
+    );
+    let (rho_a, pre) = (
+        col("plates.wing.areal_density"),
+        col("deployment.hinge.preload_angle"),
+    );
+    // Two normals: the coefficient is their Pearson correlation (sampling error
+    // (1 − ρ²)/√n).
+    let r = pearson(&k, &c);
+    let se = (1.0 - 0.36) / (n as f64).sqrt();
+    assert!((r - 0.6).abs() < 4.0 * se, "Pearson {r} vs 0.6 (se {se})");
+    // A normal and a uniform; a lognormal and a truncated normal: Spearman's ρ_S =
+    // (6/π) asin(ρ/2), distinguishable from ρ at this n.
+    for (x, y, rho) in [(&mu, &k, -0.5), (&rho_a, &pre, 0.7)] {
+        let rs = spearman(x, y);
+        let expect = spearman_of_normal(rho);
+        let se = spearman_se(expect, n);
+        assert!(
+            (rs - expect).abs() < 4.0 * se,
+            "Spearman {rs} vs (6/π)asin(ρ/2) = {expect} (se {se})"
+        );
+        assert!((rs - rho).abs() > 4.0 * se, "not told apart from ρ = {rho}");
+    }
+    // Pairs not given stay independent in normal space: damping and friction, ρ_S =
+    // (6/π) asin(0/2) = 0.
+    let rs = spearman(&c, &mu);
+    assert!(rs.abs() < 4.0 * spearman_se(0.0, n), "{rs}");
+    // Every marginal keeps its own distribution (KS against the exact CDF) and truncation.
+    let crit = ks_critical(n, 0.001);
+    for (dk, d) in mc.dispersions.iter().enumerate() {
+        let x: Vec<f64> = draws.iter().map(|v| v[dk]).collect();
+        let dks = ks_distance(&x, |y| d.distribution.cdf(y));
+        assert!(dks < crit, "{}: KS {dks} ≥ {crit}", d.path);
+    }
+    assert!(pre.iter().all(|p| (0.35..=0.48).contains(p)));
+    // summary.json's sampled Spearman of each pair is that of the applied values.
+    let records: Vec<RunRecord> = (0..2000)
+        .map(|i| RunRecord {
+            index: i as u64,
+            status: RunStatus::Ok,
+            applied: draws[i].clone(),
+            outputs: Vec::new(),
+            margins: Vec::new(),
+        })
+        .collect();
+    let a = analyse(&mc, &[], &records);
+    let pick = |p: &str| -> Vec<f64> {
+        let k = mc.dispersions.iter().position(|d| d.path == p).unwrap();
+        records.iter().map(|r| r.applied[k]).collect()
+    };
+    assert_eq!(
+        a.correlations[1],
+        spearman(
+            &pick("deployment.hinge.stiffness"),
+            &pick("deployment.hinge.friction")
+        )
+    );
+}
+
+/// y = 3 x₁ + x₂ with x₁, x₂ independent standard normals: y is normal, corr(y, x₁) =
+/// 3/√10 and corr(y, x₂) = 1/√10, and ranks are increasing maps of normal values, so the
+/// rank regression's population coefficients are Spearman's correlations of bivariate
+/// normals (independent regressors: the multiple regression's coefficients are the simple
+/// ones): SRRC_i = (6/π) asin(r_i/2), R² = Σ SRRC_i². Their ratio, 3.11, is not the 3 of the
+/// regression on the values.
+#[test]
+fn val_srrc_of_a_linear_model_matches_the_closed_form() {
+    let src = one_panel(
+        r#"[montecarlo]
+runs = 10
+seed = 31
+[montecarlo.dispersions]
+"deployment.hinge.stiffness" = { normal = [0.0, 1.0] }
+"deployment.hinge.damping" = { normal = [0.0, 1.0] }
+"deployment.hinge.friction" = { uniform = [0.0, 1.0] }
+"#,
+    );
+    let mc = parse(&src).montecarlo.unwrap();
+    let n = 100_000u64;
+    let at = |p: &str| mc.dispersions.iter().position(|d| d.path == p).unwrap();
+    let (i1, i2) = (
+        at("deployment.hinge.stiffness"),
+        at("deployment.hinge.damping"),
+    );
+    let records: Vec<RunRecord> = (0..n)
+        .map(|i| {
+            let x = mc.draw(i);
+            let y = 3.0 * x[i1] + x[i2];
+            RunRecord {
+                index: i,
+                status: RunStatus::Ok,
+                applied: x,
+                // the linear output, and an increasing map of it (same ranks)
+                outputs: vec![y, (0.5 * y).exp()],
+                margins: Vec::new(),
+            }
+        })
+        .collect();
+    let names = vec!["y".to_string(), "exp_y".to_string()];
+    let a = analyse(&mc, &names, &records);
+    let (s1, s2) = (
+        spearman_of_normal(3.0 / 10f64.sqrt()),
+        spearman_of_normal(1.0 / 10f64.sqrt()),
+    );
+    let sens = &a.sensitivity[0].1;
+    let get = |p: &str| sens.ranking.iter().find(|r| r.parameter == p).unwrap().srrc;
+    let (b1, b2, b3) = (
+        get("deployment.hinge.stiffness"),
+        get("deployment.hinge.damping"),
+        get("deployment.hinge.friction"),
+    );
+    // Standard error ≈ √((1 − R²)/n) ≈ 4e-4.
+    assert!((b1 - s1).abs() < 2e-3, "SRRC x1 {b1} vs {s1}");
+    assert!((b2 - s2).abs() < 2e-3, "SRRC x2 {b2} vs {s2}");
+    assert!(b3.abs() < 2e-3, "SRRC of the unused parameter {b3}");
+    assert!(
+        (sens.r2 - (s1 * s1 + s2 * s2)).abs() < 2e-3,
+        "R² {}",
+        sens.r2
+    );
+    assert!(((b1 / b2) - s1 / s2).abs() < 0.03 && (b1 / b2 - 3.0).abs() > 0.08);
+    assert_eq!(sens.ranking[0].parameter, "deployment.hinge.stiffness");
+    assert_eq!(sens.runs, n as usize);
+    // Ranks do not see an increasing map: the same coefficients for exp(y/2).
+    assert_eq!(a.sensitivity[1].1, a.sensitivity[0].1);
+    // The library function agrees with the analysis.
+    let xs: Vec<Vec<f64>> = (0..3)
+        .map(|k| records.iter().map(|r| r.applied[k]).collect())
+        .collect();
+    let y: Vec<f64> = records.iter().map(|r| r.outputs[0]).collect();
+    assert_eq!(rank_regression(&xs, &y).r2, sens.r2);
+}
+
+/// One panel on a held hub, rigid latch: it reaches the latch at ω = √(k/J) √(α_ref² −
+/// (α_ref − α_L)²) (energy, from rest at α = 0), and the latch stops it: the hinge carries
+/// the angular impulse J ω (its angular momentum about the fixed hinge). Compliant latch
+/// (k_L, no damping, the hinge spring acting on): after capture J θ̈ = k p − (k + k_L) θ
+/// (θ = α − α_L, p = α_ref − α_L), so the latch moment k_L θ peaks at k_L (θ_e +
+/// √(θ_e² + ω²/Ω²)), θ_e = k p/(k + k_L), Ω² = (k + k_L)/J.
+#[test]
+fn val_latch_loads_and_the_factor_of_safety_match_the_closed_form() {
+    let req = |fos: f64, max: f64| {
+        format!(
+            "[[montecarlo.requirements]]\nname = \"latch load\"\noutput = \"latch_impulse.1\"\n\
+             max = {max:?}\nfactor_of_safety = {fos:?}\nprobability = 0.9\nconfidence = 0.9\n"
+        )
+    };
+    let mc_section = |extra: &str| {
+        format!(
+            "[montecarlo]\nruns = 60\nseed = 3\n[montecarlo.dispersions]\n\
+             \"deployment.hinge.stiffness\" = {{ normal = [3.0, 0.3] }}\n{extra}"
+        )
+    };
+    // The panel's J about its hinge, and ω at the latch, for stiffness k.
+    let probe = parse(&one_panel(&mc_section("")));
+    let d = probe.deployment.as_ref().unwrap();
+    let (c, _) = simulate_coupled(&probe.structure, d).unwrap();
+    let (p, h) = (&c.chain.panels[0], &c.chain.hinges[0]);
+    let j = c.panel_inertia[0][2] + 0.25 * p.mass * p.length * p.length;
+    let (a_ref, a_l) = (h.reference_angle, h.latch_angle);
+    let omega = |k: f64| (k / j).sqrt() * (a_ref * a_ref - (a_ref - a_l).powi(2)).sqrt();
+    // Rigid: the impulse, and a requirement 2 × impulse ≤ max.
+    let impulses: Vec<f64> = {
+        let s = parse(&one_panel(&mc_section("")));
+        let mc = s.montecarlo.clone().unwrap();
+        (0..60).map(|i| j * omega(mc.draw(i)[0])).collect()
+    };
+    let mut sorted = impulses.clone();
+    sorted.sort_by(f64::total_cmp);
+    // An allowable that twice the median impulse meets: about half the runs fail.
+    let max = 2.0 * (sorted[29] + sorted[30]) / 2.0;
+    let s = parse(&one_panel(&(mc_section("") + &req(2.0, max))));
+    let mc = s.montecarlo.clone().unwrap();
+    let d = s.deployment.as_ref().unwrap();
+    let names = output_names(&s.structure, d, false);
+    let col = names.iter().position(|n| n == "latch_impulse.1").unwrap();
+    let records = run_many(&s, &mc, &(0..60).collect::<Vec<_>>(), &|| ());
+    for (r, exact) in records.iter().zip(&impulses) {
+        assert!(
+            (r.outputs[col] - exact).abs() < 1e-6 * exact,
+            "run {}: latch impulse {} vs J ω = {exact}",
+            r.index,
+            r.outputs[col]
+        );
+    }
+    let a = analyse(&mc, &names, &records);
+    let v = &a.verdicts[0];
+    let expected_failures = impulses.iter().filter(|m| 2.0 * **m > max).count() as u64;
+    assert_eq!(v.failures, expected_failures);
+    assert_eq!(v.failures, 30);
+    // The tolerance bound is on 2 × impulse: the (n − f_allowed)-th smallest of 2 J ω.
+    let f = v.allowed.unwrap() as usize;
+    let bound = v.tolerance_bound.unwrap();
+    assert!((bound - 2.0 * sorted[59 - f]).abs() < 1e-6 * bound);
+    // Compliant: the peak latch moment of every run against its closed form.
+    let kl = 400.0;
+    let s = parse(&one_panel(&mc_section("")).replace(
+        "preload_angle = 0.4\n",
+        &format!(
+            "preload_angle = 0.4\n[deployment.latch]\nmodel = \"compliant\"\nstiffness = {kl:?}\n\
+             damping = 0.0\nsettle_time = 1.0\n"
+        ),
+    ));
+    let mc = s.montecarlo.clone().unwrap();
+    let d = s.deployment.as_ref().unwrap();
+    let names = output_names(&s.structure, d, false);
+    let col = names
+        .iter()
+        .position(|n| n == "peak_latch_moment.1")
+        .unwrap();
+    assert!(!names.iter().any(|n| n.starts_with("latch_impulse")));
+    for r in run_many(&s, &mc, &(0..12).collect::<Vec<_>>(), &|| ()) {
+        let k = r.applied[0];
+        let w = omega(k);
+        let p = a_ref - a_l;
+        let theta_e = k * p / (k + kl);
+        let big_omega2 = (k + kl) / j;
+        let exact = kl * (theta_e + (theta_e * theta_e + w * w / big_omega2).sqrt());
+        assert!(
+            (r.outputs[col] - exact).abs() < 1e-5 * exact,
+            "run {}: peak latch moment {} vs {exact}",
+            r.index,
+            r.outputs[col]
+        );
+    }
+}
+
+/// `flexcraft montecarlo` on `text` (its runs.csv as header and rows), and `flexcraft
+/// simulate` on the scenario `--run i` writes for run i (its summary.json).
+fn mc_and_simulate(
+    dir: &Path,
+    name: &str,
+    text: &str,
+    run: usize,
+) -> (Vec<String>, Vec<Vec<String>>, serde_json::Value) {
+    let scen = write(dir, &format!("{name}.toml"), text);
+    let out = dir.join(format!("{name}_mc"));
+    ok(&mc(&[
+        scen.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "-q".as_ref(),
+    ]));
+    let (header, table) = rows(&out);
+    let one = dir.join(format!("{name}_run{run}"));
+    ok(&mc(&[
+        scen.as_os_str(),
+        "--run".as_ref(),
+        run.to_string().as_ref(),
+        "--out".as_ref(),
+        one.as_os_str(),
+    ]));
+    let sim = dir.join(format!("{name}_sim{run}"));
+    ok(&bin()
+        .arg("simulate")
+        .arg(one.join("scenario.toml"))
+        .arg("--out")
+        .arg(&sim)
+        .output()
+        .unwrap());
+    let summary =
+        serde_json::from_str(&std::fs::read_to_string(sim.join("summary.json")).unwrap()).unwrap();
+    (header, table, summary)
+}
+
+/// The per-run response outputs against `flexcraft simulate` (a second code path: the run's
+/// written scenario parsed again, its own modal analysis, the full response with every
+/// channel, summary.json), on the seed deployment of examples/montecarlo.toml (rigid base)
+/// with compliant latches (a rigid latch stops the array on a rigid base: nothing would
+/// vibrate; the latch springs' motion at the hand-over does): with deployment keys dispersed
+/// only (the runs share the base's modes), and with the wing's areal density dispersed too
+/// (each run has its own structure and modes).
+#[test]
+fn val_response_peak_deflections_equal_the_simulate_summary() {
+    let dir = scratch("mc_response");
+    let example = std::fs::read_to_string(super::common::example("montecarlo.toml")).unwrap();
+    let with = |runs: u64, keep_density: bool, sd: &str| {
+        let mut t = example
+            .replace("runs = 250 ", &format!("runs = {runs} "))
+            .replace("seed = 20261122\n", "seed = 20261122\nresponse = true\n")
+            .replace("normal = [1.283, 0.04]", &format!("normal = [1.283, {sd}]"))
+            .replace(
+                "[montecarlo]\n",
+                "[response]\nduration = 4.0\noutput_rate = 50.0\n\n[montecarlo]\n",
+            )
+            .replace(
+                "[deployment.hinge]\n",
+                "[deployment.latch]\nmodel = \"compliant\"\nstiffness = 1.0e4\ndamping = 10.0\n\
+                 settle_time = 2.0\n\n[deployment.hinge]\n",
+            );
+        if !keep_density {
+            t = t.replace(
+                "\"plates.wing.areal_density\" = { lognormal = [2.0794, 0.02] }",
+                "",
+            );
+        }
+        assert!(t.contains("response = true") && t.contains(&format!("runs = {runs}")));
+        t
+    };
+    for (name, text, run) in [
+        ("deployment_keys", with(1, false, "0.04"), 0),
+        ("structure_key", with(2, true, "0.04"), 1),
+    ] {
+        let (header, table, summary) = mc_and_simulate(&dir, name, &text, run);
+        let channels = summary["response"]["channels"].as_array().unwrap();
+        // Rounding noise (a deflection that is zero by symmetry) compares against the
+        // largest peak.
+        let scale = channels
+            .iter()
+            .filter(|c| c["unit"] == "m")
+            .map(|c| c["peak"].as_f64().unwrap())
+            .fold(0.0, f64::max);
+        for (output, channel) in [
+            ("peak_tip_deflection.mast.v", "mast_tip_v"),
+            ("peak_tip_deflection.mast.w", "mast_tip_w"),
+            ("peak_tip_deflection.wing.minus", "wing_tip_minus"),
+            ("peak_tip_deflection.wing.plus", "wing_tip_plus"),
+        ] {
+            let col = header.iter().position(|h| h == output).unwrap();
+            let got: f64 = table[run][col].parse().unwrap();
+            let want = channels.iter().find(|c| c["name"] == channel).unwrap()["peak"]
+                .as_f64()
+                .unwrap();
+            assert!(got.is_finite(), "{name}: {output}");
+            assert!(
+                (got - want).abs() <= 1e-12 * scale,
+                "{name}: {output} {got} vs simulate {want}"
+            );
+        }
+        let wing = header
+            .iter()
+            .position(|h| h == "peak_tip_deflection.wing.plus")
+            .unwrap();
+        assert!(
+            table[run][wing].parse::<f64>().unwrap() > 1e-3,
+            "{name}: the wing vibrates"
+        );
+    }
+    // No dispersion (σ = 0, the other keys not dispersed): every run is the same run.
+    let text = with(3, false, "0.0")
+        .lines()
+        .filter(|l| {
+            !l.starts_with("\"deployment.hinge.preload_angle\"")
+                && !l.starts_with("\"deployment.hinge.friction\"")
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let scen = write(&dir, "zero.toml", &text);
+    let out = dir.join("zero_mc");
+    ok(&mc(&[scen.as_os_str(), "--out".as_ref(), out.as_os_str()]));
+    let (header, table) = rows(&out);
+    assert!(header.iter().any(|h| h.starts_with("peak_tip_deflection.")));
+    assert_eq!(table.len(), 3);
+    for row in &table[1..] {
+        assert_eq!(row[1..], table[0][1..]);
+    }
 }
