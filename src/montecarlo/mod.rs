@@ -227,6 +227,20 @@ pub fn output_names(st: &Structure, d: &Deployment, response: bool) -> Vec<Strin
     v
 }
 
+/// The SI unit of a per-run output of [`output_names`] ("-" for the 0/1 flags).
+pub fn output_unit(name: &str) -> &'static str {
+    match name.split('.').next().unwrap_or(name) {
+        "latch_time" | "final_latch_time" => "s",
+        "all_latched" | "swing_back" => "-",
+        "min_swing_angle" | "hub_attitude_excursion" => "rad",
+        "energy_lost" => "J",
+        "peak_hinge_force" | "peak_root_force" => "N",
+        "peak_hinge_moment" | "peak_latch_moment" | "peak_root_moment" => "N·m",
+        "latch_impulse" => "N·m·s",
+        _ => "m",
+    }
+}
+
 /// The response outputs: per beam its tip's v and w, per plate its two tip corners, as
 /// (output name, the name of `flexcraft simulate`'s response channel).
 fn deflection_channels(st: &Structure) -> Vec<(String, String)> {

@@ -53,7 +53,13 @@ fn runs_csv(
     let csv_err = |e: csv::Error| OutputError::Io(std::io::Error::other(e.to_string()));
     let mut header = vec!["run".to_string(), "status".to_string()];
     header.extend(mc.dispersions.iter().map(|d| d.path.clone()));
-    header.extend(names.iter().cloned());
+    // The applied values are in their keys' own (SI) units, as written in the scenario; the
+    // outputs carry theirs.
+    header.extend(
+        names
+            .iter()
+            .map(|n| format!("{n} [{}]", crate::montecarlo::output_unit(n))),
+    );
     w.write_record(&header).map_err(csv_err)?;
     for r in records {
         let mut row = vec![r.index.to_string(), r.status.name().to_string()];
@@ -67,9 +73,9 @@ fn runs_csv(
 
 /// torque_margin.csv: per fraction of the travel, every hinge's worst margin.
 fn margin_csv(margins: &[Vec<f64>]) -> String {
-    let mut s = String::from("travel fraction");
+    let mut s = String::from("travel fraction [-]");
     for h in 1..=margins.len() {
-        s += &format!(",hinge {h} margin");
+        s += &format!(",hinge {h} torque margin [-] (1 = 100 %)");
     }
     s.push('\n');
     for j in 0..MARGIN_POINTS {

@@ -358,7 +358,12 @@ impl Scenario {
             let (a, b) = d.distribution.probes();
             let at = |v: f64| {
                 self.with_values(&[(d.path.as_str(), v.into())])
-                    .map_err(|e| err(format!("at {v}: {}: {}", e.key, e.reason)))
+                    .map_err(|e| {
+                        err(format!(
+                            "{}: {} (probed with the value {v})",
+                            e.key, e.reason
+                        ))
+                    })
             };
             let (sa, sb) = (at(a)?, at(b)?);
             if a != b && fingerprint(&sa) == fingerprint(&sb) {

@@ -85,7 +85,7 @@ impl<'a> Cursor<'a> {
                     Err(_) => a
                         .iter()
                         .position(|t| t.get("name").and_then(Item::as_str) == Some(seg))
-                        .ok_or_else(|| format!("no element is named {seg:?}"))?,
+                        .ok_or_else(|| format!("no table of this array has name = {seg:?}"))?,
                 };
                 Ok(Cursor::Table(a.get_mut(idx).expect("index checked")))
             }
@@ -373,7 +373,7 @@ mod tests {
             (
                 "beams.mats.length",
                 OverrideValue::Number(1.0),
-                "no element is named",
+                "no table of this array has name =",
             ),
             ("beams.3.length", OverrideValue::Number(1.0), "outside 1…1"),
             ("hub.motion.x", OverrideValue::Number(1.0), "is a value"),
