@@ -240,3 +240,27 @@ impl Mul<f64> for Mat3 {
         Mat3(self.0.map(|r| r.map(|v| v * s)))
     }
 }
+
+/// The lower Cholesky factor L (row-major k × k, L Lᵀ = A) of the symmetric k × k matrix `a`
+/// (row-major, lower triangle read), or the first pivot that is not above `min_pivot`.
+/// Hand-written for the small dense matrices of the Monte Carlo statistics (a correlation
+/// matrix, the rank regression's normal equations): a few dozen rows, where a call into a
+/// linear-algebra crate costs more than the arithmetic.
+pub fn cholesky_lower(a: &[f64], k: usize, min_pivot: f64) -> Result<Vec<f64>, f64> {
+    let mut l = vec![0.0; k * k];
+    for i in 0..k {
+        for j in 0..=i {
+            let s: f64 = (0..j).map(|m| l[i * k + m] * l[j * k + m]).sum();
+            if i == j {
+                let d = a[i * k + i] - s;
+                if d <= min_pivot {
+                    return Err(d);
+                }
+                l[i * k + i] = d.sqrt();
+            } else {
+                l[i * k + j] = (a[i * k + j] - s) / l[j * k + j];
+            }
+        }
+    }
+    Ok(l)
+}

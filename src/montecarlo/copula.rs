@@ -111,22 +111,7 @@ pub struct Copula {
 
 /// The lower Cholesky factor of the k × k matrix `c` (row-major), or the failing pivot.
 fn cholesky(c: &[f64], k: usize) -> Result<Vec<f64>, f64> {
-    let mut l = vec![0.0; k * k];
-    for i in 0..k {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|m| l[i * k + m] * l[j * k + m]).sum();
-            if i == j {
-                let d = c[i * k + i] - s;
-                if d <= MIN_PIVOT {
-                    return Err(d);
-                }
-                l[i * k + i] = d.sqrt();
-            } else {
-                l[i * k + j] = (c[i * k + j] - s) / l[j * k + j];
-            }
-        }
-    }
-    Ok(l)
+    crate::math::cholesky_lower(c, k, MIN_PIVOT)
 }
 
 impl Copula {

@@ -195,21 +195,9 @@ pub fn regress_ranks(xranks: &[Vec<f64>], yranks: &[f64]) -> RankRegression {
     }
     let r: Vec<f64> = cols.iter().map(|(_, z)| dot(z, &ry)).collect();
     // Cholesky of R_xx (symmetric positive definite unless the ranks are collinear).
-    let mut l = vec![0.0; m * m];
-    for i in 0..m {
-        for j in 0..=i {
-            let s: f64 = (0..j).map(|q| l[i * m + q] * l[j * m + q]).sum();
-            if i == j {
-                let d = a[i * m + i] - s;
-                if d <= 1e-12 {
-                    return undetermined;
-                }
-                l[i * m + i] = d.sqrt();
-            } else {
-                l[i * m + j] = (a[i * m + j] - s) / l[j * m + j];
-            }
-        }
-    }
+    let Ok(l) = crate::math::cholesky_lower(&a, m, 1e-12) else {
+        return undetermined;
+    };
     let mut b = r.clone();
     for i in 0..m {
         b[i] = (b[i] - (0..i).map(|q| l[i * m + q] * b[q]).sum::<f64>()) / l[i * m + i];
