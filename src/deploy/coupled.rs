@@ -1446,6 +1446,7 @@ impl Coupled {
             output_rate: 1.0 / end_time,
             tolerance: tol,
             integrator: super::Integrator::Explicit,
+            record_samples: true,
             settle_time: self
                 .latch
                 .as_ref()

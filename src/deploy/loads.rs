@@ -269,6 +269,15 @@ impl Engine for Coupled {
             out.push(l[..3].iter().map(|x| x * x).sum::<f64>().sqrt());
             out.push(l[3..].iter().map(|x| x * x).sum::<f64>().sqrt());
         }
+        // Then every hinge's in-plane reaction force and transmitted moment (the samples'
+        // `force` and `moment`), and the hub's excursion: |rotation vector| and |position|.
+        let hinges = self.hinge_loads(y, &ev, &sol);
+        out.extend(hinges.iter().map(|(f, _)| f.get(0).hypot(f.get(1))));
+        out.extend(hinges.iter().map(|(_, m)| m.get(2).abs()));
+        let v = self.view(y);
+        let norm = |x: [f64; 3]| (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        out.push(norm(attitude::rotation_vector(v.quat).0));
+        out.push(norm(v.r.0));
         out
     }
     fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample {

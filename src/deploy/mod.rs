@@ -138,6 +138,10 @@ pub struct RunSettings {
     pub integrator: Integrator,
     /// With compliant latches: how long the run continues after the last capture, s.
     pub settle_time: Option<f64>,
+    /// Record the samples at k / output_rate (false: only the first, those at the latch
+    /// events and the load peaks tracked at every step — what a Monte Carlo run reads;
+    /// building a sample evaluates the whole model and was 58 % of such a run).
+    pub record_samples: bool,
 }
 
 /// The three-dimensional state of the coupled model at a sample (hub and base quantities;
@@ -318,7 +322,8 @@ pub struct DeploymentResult {
     pub evaluations: usize,
     /// Peaks of the engine's tracked load magnitudes ([`peaks`]), observed at every step
     /// (coupled model: every hinge's latch moment, then every base beam's root force and
-    /// root moment).
+    /// root moment, then every hinge's reaction force, every hinge's transmitted moment, and
+    /// the hub's |rotation vector| and |position|).
     pub load_peaks: Vec<peaks::Peak>,
 }
 
@@ -360,8 +365,23 @@ pub fn simulate_coupled(
     st: &Structure,
     d: &Deployment,
 ) -> Result<(Coupled, DeploymentResult), DeployError> {
+    simulate_coupled_with(st, d, true)
+}
+
+/// [`simulate_coupled`] without the periodic samples when `record_samples` is false: the
+/// latch events, the first sample and the load peaks ([`DeploymentResult::load_peaks`],
+/// tracked at every step) are the same, the run costs less than half (a Monte Carlo run).
+pub fn simulate_coupled_with(
+    st: &Structure,
+    d: &Deployment,
+    record_samples: bool,
+) -> Result<(Coupled, DeploymentResult), DeployError> {
     let c = d.coupled(st)?;
-    let mut r = run::run(&c, &d.settings(), MAX_STEPS);
+    let settings = RunSettings {
+        record_samples,
+        ..d.settings()
+    };
+    let mut r = run::run(&c, &settings, MAX_STEPS);
     truncation_check(st, d, &c, &mut r)?;
     if let BaseKind::Flexible {
         modes: Some(requested),
@@ -475,6 +495,7 @@ impl Deployment {
                     Some(settle_time.unwrap_or_else(|| settle_time_default(&self.chain, stiffness)))
                 }
             },
+            record_samples: true,
         }
     }
 

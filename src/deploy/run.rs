@@ -395,12 +395,14 @@ impl<'a, E: Engine> Run<'a, E> {
                 .engine
                 .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
             self.peaks.observe(tk, &m);
-            self.samples.push(self.sys.engine.sample(
-                tk,
-                &self.buf,
-                &self.sys.free,
-                &self.sys.captured,
-            ));
+            if self.s.record_samples {
+                self.samples.push(self.sys.engine.sample(
+                    tk,
+                    &self.buf,
+                    &self.sys.free,
+                    &self.sys.captured,
+                ));
+            }
             self.next_k += 1;
         }
     }

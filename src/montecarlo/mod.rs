@@ -13,7 +13,7 @@ pub mod order;
 pub mod stats;
 
 use crate::deploy::coupled::Coupled;
-use crate::deploy::{simulate_coupled, Deployment, DeploymentResult, LatchModel};
+use crate::deploy::{simulate_coupled_with, Deployment, DeploymentResult, LatchModel};
 use crate::response::channels::standard_channels;
 use crate::response::handover::hand_over_coupled;
 use crate::response::{Channel, ModalResponse, ResponseError};
@@ -306,21 +306,15 @@ pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult
         lost[e.hinge - 1] += e.energy_before - e.energy_after;
     }
     v.extend(lost);
-    let (mut force, mut moment) = (vec![0.0_f64; n], vec![0.0_f64; n]);
-    let (mut att, mut pos) = (0.0_f64, 0.0_f64);
-    for s in &r.samples {
-        for i in 0..n.min(s.force.len()) {
-            force[i] = force[i].max(s.force[i][0].hypot(s.force[i][1]));
-            moment[i] = moment[i].max(s.moment[i].abs());
-        }
-        let (a, p) = match &s.body {
-            Some(b) => (norm(b.hub_rotation), norm(b.hub_position)),
-            None => (s.hub[2].abs(), s.hub[0].hypot(s.hub[1])),
-        };
-        (att, pos) = (att.max(a), pos.max(p));
-    }
-    v.extend(force);
-    v.extend(moment);
+    // The coupled model's tracked peaks (DeploymentResult::load_peaks): latch moments (n),
+    // root force and moment per base beam, hinge reaction forces (n), hinge moments (n),
+    // |hub rotation|, |hub position| — at every step, not only at the samples.
+    let beams = c.base.beams.len();
+    let peak = |i: usize| r.load_peaks.get(i).map_or(f64::NAN, |p| p.0);
+    let tracked = n + 2 * beams;
+    v.extend((0..n).map(|h| peak(tracked + h)));
+    v.extend((0..n).map(|h| peak(tracked + n + h)));
+    let (att, pos) = (peak(tracked + 2 * n), peak(tracked + 2 * n + 1));
     match d.latch {
         LatchModel::Rigid => {
             let mut impulse = vec![0.0_f64; n];
@@ -354,10 +348,6 @@ pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult
     v.push(att);
     v.push(pos);
     v
-}
-
-fn norm(x: [f64; 3]) -> f64 {
-    (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
 }
 
 /// The static torque margin of every hinge over its travel from the initial to the latch
@@ -513,7 +503,9 @@ impl<'a> Runner<'a> {
                 Err(_) => return empty(RunStatus::Refused),
             },
         };
-        let Ok((c, r)) = simulate_coupled(&s.structure, &d) else {
+        // Without the periodic samples: every output below is read from the latch events and
+        // the load peaks tracked at every step.
+        let Ok((c, r)) = simulate_coupled_with(&s.structure, &d, false) else {
             return empty(RunStatus::Failed);
         };
         let mut out = outputs(&s.structure, &d, &c, &r);

@@ -71,22 +71,17 @@ pub fn peak_root_loads(c: &Coupled, r: &DeploymentResult) -> Value {
 }
 
 /// Per hinge, the largest in-plane reaction force (N) and transmitted moment (N·m) over the
-/// deployment's samples, with their times.
-pub fn peak_hinge_reactions(r: &DeploymentResult) -> Value {
-    let n = r.samples.first().map_or(0, |s| s.force.len());
+/// deployment, with their times: tracked at every integration step
+/// (`DeploymentResult::load_peaks`, after the latch moments and the beams' root loads), as
+/// the Monte Carlo outputs `peak_hinge_force.H` and `peak_hinge_moment.H` are.
+pub fn peak_hinge_reactions(c: &Coupled, r: &DeploymentResult) -> Value {
+    let n = c.panels();
+    let first = n + 2 * c.base.beams.len();
+    let at = |i: usize| r.load_peaks.get(i).copied().unwrap_or((0.0, 0.0));
     Value::Array(
         (0..n)
             .map(|i| {
-                let (mut f, mut tf, mut m, mut tm) = (0.0, 0.0, 0.0, 0.0);
-                for s in &r.samples {
-                    let fi = s.force[i][0].hypot(s.force[i][1]);
-                    if fi > f {
-                        (f, tf) = (fi, s.t);
-                    }
-                    if s.moment[i].abs() > m {
-                        (m, tm) = (s.moment[i].abs(), s.t);
-                    }
-                }
+                let ((f, tf), (m, tm)) = (at(first + i), at(first + n + i));
                 json!({"hinge": i + 1, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
             })
             .collect(),
@@ -205,7 +200,7 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "warnings": r.warnings.iter().map(ToString::to_string).collect::<Vec<_>>(),
         "hub": hub_json(c, r),
         "peak_root_loads": peak_root_loads(c, r),
-        "peak_hinge_reactions": peak_hinge_reactions(r),
+        "peak_hinge_reactions": peak_hinge_reactions(c, r),
         "peak_latch_moments": peak_latch_moments(r),
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()

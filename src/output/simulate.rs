@@ -198,7 +198,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
                 "base_impulse": e.base_impulse.map(|(f, m)| json!({"force": f, "moment": m})),
             })).collect::<Vec<_>>(),
             "peak_root_loads": super::deploy::peak_root_loads(&sim.coupled, dep),
-            "peak_hinge_reactions": super::deploy::peak_hinge_reactions(dep),
+            "peak_hinge_reactions": super::deploy::peak_hinge_reactions(&sim.coupled, dep),
             "captures": dep.captures.iter().map(|k| json!({"time": k.time, "hinge": k.hinge, "rates": k.rates})).collect::<Vec<_>>(),
             "peak_latch_moments": super::deploy::peak_latch_moments(dep),
         },
