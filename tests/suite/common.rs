@@ -201,3 +201,43 @@ pub fn assert_same_tree(a: &std::path::Path, b: &std::path::Path) -> usize {
     }
     x.len()
 }
+
+/// One 2 m, 10 kg panel (5 kg/m², 2 m × 1 m) on a held 100 kg hub without beams (a rigid
+/// base), hinge spring k = 3 N·m/rad preloaded 0.4 rad beyond the latch at π/2, no friction
+/// or damping, deploying over 20 s at `output_rate` and `tolerance`; `extra` is appended
+/// (a latch or a [montecarlo] section). The closed-form deployment of the Monte Carlo and
+/// compliant-latch tests.
+pub fn one_panel(name: &str, output_rate: f64, tolerance: f64, extra: &str) -> String {
+    format!(
+        r#"
+name = "{name}"
+[hub]
+motion = "fixed"
+mass = 100.0
+inertia = [10.0, 10.0, 10.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[[plates]]
+name = "wing"
+parent = "hub"
+root = [0.5, 0.0, 0.0]
+length_axis = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+length = 2.0
+width = 1.0
+areal_density = 5.0
+bending_stiffness = 1.0e4
+poisson_ratio = 0.3
+terms = {{ length = 3, width = 2 }}
+[deployment]
+plate = "wing"
+panels = 1
+end_time = 20.0
+output_rate = {output_rate:?}
+tolerance = {tolerance:e}
+[deployment.hinge]
+stiffness = 3.0
+preload_angle = 0.4
+{extra}
+"#
+    )
+}

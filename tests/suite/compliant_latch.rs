@@ -6,37 +6,7 @@ use flexcraft::Scenario;
 /// One 2 m, 10 kg panel on a held hub (no beams: a rigid base), hinge spring k = 3 N·m/rad
 /// preloaded 0.4 rad, compliant latch k_L, c_L.
 fn one_panel(latch: &str) -> String {
-    format!(
-        r#"
-name = "one panel, compliant latch"
-[hub]
-motion = "fixed"
-mass = 100.0
-inertia = [10.0, 10.0, 10.0]
-center_of_mass = [0.0, 0.0, 0.0]
-[[plates]]
-name = "wing"
-parent = "hub"
-root = [0.5, 0.0, 0.0]
-length_axis = [1.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-length = 2.0
-width = 1.0
-areal_density = 5.0
-bending_stiffness = 1.0e4
-poisson_ratio = 0.3
-[deployment]
-plate = "wing"
-panels = 1
-end_time = 20.0
-output_rate = 50.0
-tolerance = 1e-13
-[deployment.hinge]
-stiffness = 3.0
-preload_angle = 0.4
-{latch}
-"#
-    )
+    super::common::one_panel("one panel, compliant latch", 50.0, 1e-13, latch)
 }
 
 /// Before capture: J α̈ = k (α_ref − α) from rest, so the capture rate is

@@ -16,38 +16,7 @@ use std::path::Path;
 /// 0.4 rad beyond the latch at π/2, no friction or damping, rigid latch; `extra` is appended
 /// (the [montecarlo] section).
 fn one_panel(extra: &str) -> String {
-    format!(
-        r#"
-name = "one panel"
-[hub]
-motion = "fixed"
-mass = 100.0
-inertia = [10.0, 10.0, 10.0]
-center_of_mass = [0.0, 0.0, 0.0]
-[[plates]]
-name = "wing"
-parent = "hub"
-root = [0.5, 0.0, 0.0]
-length_axis = [1.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-length = 2.0
-width = 1.0
-areal_density = 5.0
-bending_stiffness = 1.0e4
-poisson_ratio = 0.3
-terms = {{ length = 3, width = 2 }}
-[deployment]
-plate = "wing"
-panels = 1
-end_time = 20.0
-output_rate = 10.0
-tolerance = 1e-10
-[deployment.hinge]
-stiffness = 3.0
-preload_angle = 0.4
-{extra}
-"#
-    )
+    super::common::one_panel("one panel", 10.0, 1e-10, extra)
 }
 
 fn parse(src: &str) -> Scenario {
