@@ -203,6 +203,57 @@ impl Coupled {
     }
 }
 
+/// Where each load the coupled model tracks at every step sits in its
+/// `Engine::load_magnitudes` and so in [`super::DeploymentResult::load_peaks`]: every hinge's
+/// latch moment, every base beam's root force and root moment, every hinge's reaction force,
+/// every hinge's transmitted moment, the hub's |rotation vector| and |position|.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrackedLoads {
+    hinges: usize,
+    beams: usize,
+}
+
+impl TrackedLoads {
+    /// Hinge h's (0-based) latch moment magnitude, N·m.
+    pub fn latch_moment(self, h: usize) -> usize {
+        h
+    }
+    /// Base beam b's (0-based, [`super::base::BaseModel::beams`] order) root force, N.
+    pub fn root_force(self, b: usize) -> usize {
+        self.hinges + 2 * b
+    }
+    /// Base beam b's root moment, N·m.
+    pub fn root_moment(self, b: usize) -> usize {
+        self.hinges + 2 * b + 1
+    }
+    /// Hinge h's in-plane reaction force, N.
+    pub fn hinge_force(self, h: usize) -> usize {
+        self.hinges + 2 * self.beams + h
+    }
+    /// Hinge h's transmitted moment, N·m.
+    pub fn hinge_moment(self, h: usize) -> usize {
+        2 * self.hinges + 2 * self.beams + h
+    }
+    /// The hub's |rotation vector|, rad.
+    pub fn hub_rotation(self) -> usize {
+        3 * self.hinges + 2 * self.beams
+    }
+    /// The hub's |position|, m.
+    pub fn hub_position(self) -> usize {
+        3 * self.hinges + 2 * self.beams + 1
+    }
+}
+
+impl Coupled {
+    /// The layout of the loads tracked at every step.
+    pub fn tracked_loads(&self) -> TrackedLoads {
+        TrackedLoads {
+            hinges: self.panels(),
+            beams: self.base.beams.len(),
+        }
+    }
+}
+
 impl Engine for Coupled {
     fn hinges(&self) -> &[Hinge] {
         &self.chain.hinges
@@ -270,7 +321,8 @@ impl Engine for Coupled {
             out.push(l[3..].iter().map(|x| x * x).sum::<f64>().sqrt());
         }
         // Then every hinge's in-plane reaction force and transmitted moment (the samples'
-        // `force` and `moment`), and the hub's excursion: |rotation vector| and |position|.
+        // `force` and `moment`), and the hub's excursion: |rotation vector| and |position|
+        // (the layout of [`TrackedLoads`]).
         let hinges = self.hinge_loads(y, &ev, &sol);
         out.extend(hinges.iter().map(|(f, _)| f.get(0).hypot(f.get(1))));
         out.extend(hinges.iter().map(|(_, m)| m.get(2).abs()));

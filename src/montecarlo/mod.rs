@@ -306,15 +306,12 @@ pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult
         lost[e.hinge - 1] += e.energy_before - e.energy_after;
     }
     v.extend(lost);
-    // The coupled model's tracked peaks (DeploymentResult::load_peaks): latch moments (n),
-    // root force and moment per base beam, hinge reaction forces (n), hinge moments (n),
-    // |hub rotation|, |hub position| — at every step, not only at the samples.
-    let beams = c.base.beams.len();
+    // The coupled model's peaks tracked at every step, not only at the samples.
+    let t = c.tracked_loads();
     let peak = |i: usize| r.load_peaks.get(i).map_or(f64::NAN, |p| p.0);
-    let tracked = n + 2 * beams;
-    v.extend((0..n).map(|h| peak(tracked + h)));
-    v.extend((0..n).map(|h| peak(tracked + n + h)));
-    let (att, pos) = (peak(tracked + 2 * n), peak(tracked + 2 * n + 1));
+    v.extend((0..n).map(|h| peak(t.hinge_force(h))));
+    v.extend((0..n).map(|h| peak(t.hinge_moment(h))));
+    let (att, pos) = (peak(t.hub_rotation()), peak(t.hub_position()));
     match d.latch {
         LatchModel::Rigid => {
             let mut impulse = vec![0.0_f64; n];
@@ -328,22 +325,19 @@ pub fn outputs(st: &Structure, d: &Deployment, c: &Coupled, r: &DeploymentResult
         LatchModel::Compliant { .. } => {
             v.extend((0..n).map(|h| {
                 let captured = r.captures.iter().any(|k| k.hinge == h + 1);
-                match r.load_peaks.get(h) {
-                    Some(p) if captured => p.0,
-                    _ => f64::NAN,
+                if captured {
+                    peak(t.latch_moment(h))
+                } else {
+                    f64::NAN
                 }
             }));
         }
     }
-    let panels = c.panels();
     for b in st.beams() {
-        let at = c.base.beams.iter().position(|x| x.name == b.name());
-        let peak = |k: usize| {
-            at.and_then(|j| r.load_peaks.get(panels + 2 * j + k))
-                .map_or(f64::NAN, |p| p.0)
-        };
-        v.push(peak(0));
-        v.push(peak(1));
+        match c.base.beams.iter().position(|x| x.name == b.name()) {
+            Some(j) => v.extend([peak(t.root_force(j)), peak(t.root_moment(j))]),
+            None => v.extend([f64::NAN; 2]),
+        }
     }
     v.push(att);
     v.push(pos);

@@ -45,16 +45,15 @@ pub use crate::deploy::peaks::Peak;
 
 /// Per base beam: its name and the largest magnitude of its root force (N) and root moment
 /// (N·m) over the deployment, with their times: tracked at every integration step
-/// (`DeploymentResult::load_peaks`: the hinges' latch moments, then each beam's force and
-/// moment).
+/// (`DeploymentResult::load_peaks`, laid out as `TrackedLoads` says).
 pub fn root_load_peaks(c: &Coupled, r: &DeploymentResult) -> Vec<(String, Peak, Peak)> {
-    let n = c.panels();
+    let t = c.tracked_loads();
     let at = |i: usize| r.load_peaks.get(i).copied().unwrap_or((0.0, 0.0));
     c.base
         .beams
         .iter()
         .enumerate()
-        .map(|(b, beam)| (beam.name.clone(), at(n + 2 * b), at(n + 2 * b + 1)))
+        .map(|(b, beam)| (beam.name.clone(), at(t.root_force(b)), at(t.root_moment(b))))
         .collect()
 }
 
@@ -72,16 +71,15 @@ pub fn peak_root_loads(c: &Coupled, r: &DeploymentResult) -> Value {
 
 /// Per hinge, the largest in-plane reaction force (N) and transmitted moment (N·m) over the
 /// deployment, with their times: tracked at every integration step
-/// (`DeploymentResult::load_peaks`, after the latch moments and the beams' root loads), as
+/// (`DeploymentResult::load_peaks`, laid out as `TrackedLoads` says), as
 /// the Monte Carlo outputs `peak_hinge_force.H` and `peak_hinge_moment.H` are.
 pub fn peak_hinge_reactions(c: &Coupled, r: &DeploymentResult) -> Value {
-    let n = c.panels();
-    let first = n + 2 * c.base.beams.len();
+    let t = c.tracked_loads();
     let at = |i: usize| r.load_peaks.get(i).copied().unwrap_or((0.0, 0.0));
     Value::Array(
-        (0..n)
+        (0..c.panels())
             .map(|i| {
-                let ((f, tf), (m, tm)) = (at(first + i), at(first + n + i));
+                let ((f, tf), (m, tm)) = (at(t.hinge_force(i)), at(t.hinge_moment(i)));
                 json!({"hinge": i + 1, "force": f, "force_time": tf, "moment": m, "moment_time": tm})
             })
             .collect(),
