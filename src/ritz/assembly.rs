@@ -594,10 +594,29 @@ pub(crate) fn plate_element(
         }
     }
     let (a2b2, a4, b4) = (a * a * b * b, a.powi(4), b.powi(4));
-    for m in 0..nx {
-        for p in 0..nx {
-            for n in 0..ny {
-                for q in 0..ny {
+    // Only the pairs of functions with some non-zero integral in each direction: the
+    // tensor-product blocks of all others vanish (for the Legendre bases most do).
+    let pairs = |i: &Integrals, n: usize| -> Vec<(usize, usize)> {
+        (0..n)
+            .flat_map(|m| (0..n).map(move |p| (m, p)))
+            .filter(|&(m, p)| {
+                [
+                    i.i00[(m, p)],
+                    i.i11[(m, p)],
+                    i.i22[(m, p)],
+                    i.i20[(m, p)],
+                    i.i20[(p, m)],
+                ]
+                .iter()
+                .any(|v| *v != 0.0)
+            })
+            .collect()
+    };
+    let (px, py) = (pairs(&ix, nx), pairs(&iy, ny));
+    for &(m, p) in &px {
+        {
+            for &(n, q) in &py {
+                {
                     let (k, l) = (m * ny + n, p * ny + q);
                     me[(6 + k, 6 + l)] = mu * area * ix.i00[(m, p)] * iy.i00[(n, q)];
                     let kxx = ix.i22[(m, p)] * iy.i00[(n, q)] / a4;
@@ -614,18 +633,25 @@ pub(crate) fn plate_element(
     (me, ke)
 }
 
+/// The columns of a 6 × n map T that are not all zero: the hub's coordinates and the
+/// parent's functions that move the attachment point. Only they take part in Tᵀ B T, so the
+/// products stay small whatever n is.
+fn support(t: &Mat<f64>) -> (Vec<usize>, Mat<f64>) {
+    let cols: Vec<usize> = (0..t.ncols())
+        .filter(|&c| (0..t.nrows()).any(|r| t[(r, c)] != 0.0))
+        .collect();
+    let ts = Mat::from_fn(t.nrows(), cols.len(), |r, c| t[(r, cols[c])]);
+    (cols, ts)
+}
+
 /// M += Tᵀ B T for a rigid body's 6×6 block B.
 fn add_rigid(mass: &mut Mat<f64>, t: &Mat<f64>, rb: &RigidBody) {
     let b = rigid_block(rb, 0);
-    let bt = &b * t;
-    let tbt = t.transpose() * &bt;
-    add_into(mass, 0, 0, &tbt);
-}
-
-fn add_into(dst: &mut Mat<f64>, r0: usize, c0: usize, src: &Mat<f64>) {
-    for j in 0..src.ncols() {
-        for i in 0..src.nrows() {
-            dst[(r0 + i, c0 + j)] += src[(i, j)];
+    let (cols, ts) = support(t);
+    let tbt = ts.transpose() * (&b * &ts);
+    for (b, &j) in cols.iter().enumerate() {
+        for (a, &i) in cols.iter().enumerate() {
+            mass[(i, j)] += tbt[(a, b)];
         }
     }
 }
@@ -640,15 +666,27 @@ fn add_element(
     ke: &Mat<f64>,
 ) {
     let ne = ke.nrows();
-    let mrr = me.submatrix(0, 0, 6, 6).to_owned();
-    let mro = me.submatrix(0, 6, 6, ne).to_owned();
-    let moo = me.submatrix(6, 6, ne, ne).to_owned();
-    let tbt = t.transpose() * (&mrr * t);
-    add_into(mass, 0, 0, &tbt);
-    let tro = t.transpose() * &mro; // n × ne
-    add_into(mass, 0, own, &tro);
-    let ort = tro.transpose().to_owned();
-    add_into(mass, own, 0, &ort);
-    add_into(mass, own, own, &moo);
-    add_into(stiffness, own, own, ke);
+    let (cols, ts) = support(t);
+    let mrr = me.submatrix(0, 0, 6, 6);
+    let mro = me.submatrix(0, 6, 6, ne);
+    let tbt = ts.transpose() * (mrr * &ts);
+    for (b, &j) in cols.iter().enumerate() {
+        for (a, &i) in cols.iter().enumerate() {
+            mass[(i, j)] += tbt[(a, b)];
+        }
+    }
+    let tro = ts.transpose() * mro; // |support| × ne
+    for c in 0..ne {
+        for (a, &i) in cols.iter().enumerate() {
+            let v = tro[(a, c)];
+            mass[(i, own + c)] += v;
+            mass[(own + c, i)] += v;
+        }
+    }
+    for j in 0..ne {
+        for i in 0..ne {
+            mass[(own + i, own + j)] += me[(6 + i, 6 + j)];
+            stiffness[(own + i, own + j)] += ke[(i, j)];
+        }
+    }
 }

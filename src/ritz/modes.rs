@@ -14,11 +14,11 @@
 //! m_eff,i,d = (φ_iᵀ M_e,d)², whose sum over a complete basis is the appendages' rigid mass.
 
 use super::assembly::{ElementKind, RitzModel, HUB_DOF};
-use super::eigen::{generalized_symmetric, lowest};
+use super::eigen::{generalized_symmetric, lowest, lowest_with, Lowest};
 use super::RitzError;
 use crate::math::Vec3;
 use crate::structure::{Attachment, ComponentId, HubMotion, RigidBody};
-use faer::{Mat, Side};
+use faer::Mat;
 
 /// One natural mode.
 #[derive(Debug, Clone)]
@@ -184,17 +184,8 @@ impl ModalAnalysis {
             }
             HubMotion::Free => {
                 modes.extend(rigid_modes(model, &mrr));
-                let (x, mt) = condensed_mass(&mee, &mer, &mrr)?;
-                let (lam, phi) = solve(&kee, &mt, wanted)?;
-                for j in 0..wanted {
-                    let mut shape = vec![0.0; n];
-                    for i in 0..ne {
-                        shape[HUB_DOF + i] = phi[(i, j)];
-                    }
-                    for r in 0..HUB_DOF {
-                        shape[r] = -(0..ne).map(|i| x[(r, i)] * phi[(i, j)]).sum::<f64>();
-                    }
-                    modes.push(elastic_mode(lam[j], shape, None));
+                for (lambda, shape) in free_elastic(m, k, wanted)? {
+                    modes.push(elastic_mode(lambda, shape, None));
                 }
             }
         }
@@ -270,48 +261,25 @@ fn solve(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>
     }
 }
 
-/// The free hub's elastic pencil: X = M_rr⁻¹ M_re (6 × n_e) and the mass with the hub's
-/// rigid motion condensed out, M̃ = M_ee − M_er M_rr⁻¹ M_re (the hub's momentum equation).
-fn condensed_mass(
-    mee: &Mat<f64>,
-    mer: &Mat<f64>,
-    mrr: &Mat<f64>,
-) -> Result<(Mat<f64>, Mat<f64>), RitzError> {
-    let ne = mee.nrows();
-    let llt = mrr
-        .llt(Side::Lower)
-        .map_err(|_| RitzError::MassNotPositiveDefinite { pivot: 0 })?;
-    let mut x = mer.transpose().to_owned();
-    faer::linalg::solvers::Solve::solve_in_place(&llt, x.as_mut());
-    let corr = mer * &x;
-    let mt = Mat::from_fn(ne, ne, |i, j| {
-        mee[(i, j)] - 0.5 * (corr[(i, j)] + corr[(j, i)])
-    });
-    Ok((x, mt))
-}
-
-/// The `count` lowest elastic circular frequencies ω [rad/s] of a model given by its mass
-/// and stiffness matrices (hub's six coordinates first): hub fixed, the pencil (K_ee, M_ee);
-/// hub free, (K_ee, M̃). Eigenvalues only, for the term selection of [`super::refine`].
-pub(crate) fn elastic_frequencies(
+/// The `count` lowest elastic modes of a free-hub model (hub's six coordinates first): ω²
+/// and the shape over all coordinates, ΦᵀMΦ = I: the eigenpairs of (K, M) M-orthogonal to
+/// the six rigid-body ones (K is zero on the hub's coordinates), whose hub coordinates
+/// follow from the elastic ones by the hub's momentum equation, q_r = −M_rr⁻¹ M_re q_e
+/// ([`lowest_with`] with the hub's null space).
+fn free_elastic(
     m: &Mat<f64>,
     k: &Mat<f64>,
-    motion: HubMotion,
     count: usize,
-) -> Result<Vec<f64>, RitzError> {
-    let ne = m.nrows() - HUB_DOF;
-    let mee = m.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
-    let kee = k.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
-    let pencil_mass = match motion {
-        HubMotion::Fixed => mee,
-        HubMotion::Free => {
-            let mer = m.submatrix(HUB_DOF, 0, ne, HUB_DOF).to_owned();
-            let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
-            condensed_mass(&mee, &mer, &mrr)?.1
-        }
+) -> Result<Vec<(f64, Vec<f64>)>, RitzError> {
+    let n = m.nrows();
+    let with = Lowest {
+        null_space: HUB_DOF,
+        start: None,
     };
-    let (lambda, _) = solve(&kee, &pencil_mass, count.min(ne))?;
-    Ok(lambda.iter().map(|l| l.max(0.0).sqrt()).collect())
+    let (lam, phi) = lowest_with(k, m, count, &with)?;
+    Ok((0..lam.len())
+        .map(|j| (lam[j], (0..n).map(|i| phi[(i, j)]).collect()))
+        .collect())
 }
 
 /// Sign convention: the largest-magnitude coordinate is positive (deterministic output).

@@ -34,9 +34,11 @@
 //! estimated by two coarser sub-blocks of the same model.
 
 use super::assembly::{ElementKind, FieldKind, RitzModel, HUB_DOF};
-use super::modes::elastic_frequencies;
+use super::eigen::{lowest_of, Lowest, Operator};
 use super::RitzError;
+use crate::structure::HubMotion;
 use crate::structure::{ComponentId, Structure, MAX_TERMS};
+use faer::sparse::Triplet;
 use faer::Mat;
 
 /// Slowest convergence rate assumed, in ω_k − ω_k,exact ≈ C n^(−p).
@@ -51,6 +53,10 @@ pub const RATE_MAX: f64 = 3.0;
 /// coarsest levels (tolerance 1e-3, ~200 coordinates) still under-estimated some modes by up
 /// to 2×, before the rates settle; 1.25 keeps those within a factor 1.6.
 pub const SAFETY: f64 = 1.25;
+/// Factor on a forward estimate ([`ahead_of`]), whose rate enters far less.
+pub const FORWARD_SAFETY: f64 = 1.0;
+/// Factor on a plate's single-direction estimates when its joint step cannot be measured.
+pub const CORNER: f64 = 2.0;
 /// Growth factor of a refinement.
 pub const GROWTH: f64 = 1.5;
 
@@ -217,12 +223,18 @@ pub struct TermSelection {
 /// matrices are an index selection of its own (the bases are hierarchical).
 struct Ceiling {
     model: RitzModel,
+    /// The model's mass and stiffness matrices as the eigen-solver holds them.
+    mass: Operator,
+    stiffness: Operator,
 }
 
 impl Ceiling {
     fn new(st: &Structure) -> Self {
+        let model = RitzModel::assemble(st);
         Self {
-            model: RitzModel::assemble(st),
+            mass: Operator::from_dense(&model.mass),
+            stiffness: Operator::from_dense(&model.stiffness),
+            model,
         }
     }
 
@@ -233,19 +245,21 @@ impl Ceiling {
     }
 
     /// The global indices of `st`'s coordinates in the ceiling model, in `st`'s own order.
-    fn indices(&self, st: &Structure) -> Vec<usize> {
+    fn indices(&self, st: &Structure) -> (Vec<usize>, Vec<Key>) {
         let mut idx: Vec<usize> = (0..HUB_DOF).collect();
-        for e in &self.model.elements {
+        let mut keys: Vec<Key> = (0..HUB_DOF).map(|i| (0, 0, i)).collect();
+        for (ei, e) in self.model.elements.iter().enumerate() {
             match e.kind {
                 ElementKind::Beam { index, .. } => {
                     let t = st.beams[index].terms;
-                    for f in &e.fields {
+                    for (fi, f) in e.fields.iter().enumerate() {
                         let n = match f.kind {
                             FieldKind::U => t.axial,
                             FieldKind::V | FieldKind::W => t.bending,
                             _ => t.torsion,
                         };
                         idx.extend(f.start..f.start + n);
+                        keys.extend((0..n).map(|j| (ei, fi, j)));
                     }
                 }
                 ElementKind::Plate { index, .. } => {
@@ -254,24 +268,89 @@ impl Ceiling {
                     let start = e.own_range().start;
                     for m in 0..t.length {
                         idx.extend((0..t.width).map(|w| start + m * full + w));
+                        keys.extend((0..t.width).map(|w| (ei, m, w)));
                     }
                 }
                 ElementKind::Rigid => {}
             }
         }
-        idx
+        (idx, keys)
     }
 
-    /// The `count` lowest elastic ω of `st`'s model.
-    fn frequencies(&self, st: &Structure, count: usize) -> Result<Vec<f64>, RitzError> {
-        let idx = self.indices(st);
-        let pick = |a: &Mat<f64>| Mat::from_fn(idx.len(), idx.len(), |i, j| a[(idx[i], idx[j])]);
-        elastic_frequencies(
-            &pick(&self.model.mass),
-            &pick(&self.model.stiffness),
-            st.hub.motion,
+    /// The `count` lowest elastic ω of `st`'s model and their eigenvectors, the iteration
+    /// started from `start` (a nested level's vectors: the functions `st` has and `start`
+    /// has not start at zero).
+    fn frequencies(
+        &self,
+        st: &Structure,
+        count: usize,
+        start: Option<&Vectors>,
+    ) -> Result<(Vec<f64>, Vectors), RitzError> {
+        let (idx, keys) = self.indices(st);
+        // The pencil: every coordinate for a free hub (whose six span K's null space), the
+        // elastic ones for a fixed one.
+        let r = match st.hub.motion {
+            HubMotion::Free => HUB_DOF,
+            HubMotion::Fixed => 0,
+        };
+        let skip = HUB_DOF - r;
+        let (idx, keys) = (&idx[skip..], keys[skip..].to_vec());
+        let start = start.map(|v| v.on(&keys));
+        let with = Lowest {
+            null_space: r,
+            start: start.as_ref(),
+        };
+        let (lambda, values) = lowest_of(
+            &pick(&self.stiffness, idx, self.model.dof()),
+            &pick(&self.mass, idx, self.model.dof()),
             count,
-        )
+            &with,
+        )?;
+        let omega = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
+        Ok((omega, Vectors { keys, values }))
+    }
+}
+
+/// The sub-matrix of rows and columns `idx` (in that order) of an n × n matrix.
+fn pick(a: &Operator, idx: &[usize], n: usize) -> Operator {
+    let mut pos = vec![usize::MAX; n];
+    for (new, &old) in idx.iter().enumerate() {
+        pos[old] = new;
+    }
+    let triplets: Vec<_> = a
+        .entries()
+        .into_iter()
+        .filter(|&(i, j, _)| pos[i] != usize::MAX && pos[j] != usize::MAX)
+        .map(|(i, j, v)| Triplet::new(pos[i], pos[j], v))
+        .collect();
+    Operator::from_triplets(idx.len(), &triplets)
+}
+
+/// A coordinate's identity across levels and ceilings: (element, field — or a plate's
+/// length index —, function — or width index —); the hub's are (0, 0, i).
+type Key = (usize, usize, usize);
+
+/// One level's eigenvectors, each row keyed by the function it belongs to.
+#[derive(Debug, Clone)]
+struct Vectors {
+    keys: Vec<Key>,
+    values: Mat<f64>,
+}
+
+impl Vectors {
+    /// The same vectors over other coordinates: zero on the functions these lack.
+    fn on(&self, keys: &[Key]) -> Mat<f64> {
+        let row: std::collections::HashMap<Key, usize> =
+            self.keys.iter().enumerate().map(|(i, k)| (*k, i)).collect();
+        let mut out = Mat::zeros(keys.len(), self.values.ncols());
+        for (i, k) in keys.iter().enumerate() {
+            if let Some(&r) = row.get(k) {
+                for j in 0..self.values.ncols() {
+                    out[(i, j)] = self.values[(r, j)];
+                }
+            }
+        }
+        out
     }
 }
 
@@ -309,6 +388,47 @@ fn remaining(steps: &[Step], k: usize) -> f64 {
     }
 }
 
+/// The error left in one mode at count n by a family whose last step is the forward one
+/// n → n′ = b n with change D (absolute, rad/s): e(n) = D + e(n′) = D b^p / (b^p − 1), the rate
+/// p fitted from the step before (the one that ended at n) when there is one, else
+/// [`RATE_MIN`]. Because D is most of e(n), the estimate depends little on the rate: at
+/// b = 1.5 the factor is 3 for p = 1, 1.42 for p = 3 and tends to 1, so between a rate of 1
+/// and any faster one it is at most 3× the truth and, with p clamped to [1, 3], never less
+/// than half of it.
+fn ahead_of(steps: &[Step], k: usize) -> f64 {
+    let Some(last) = steps.last() else {
+        return f64::INFINITY;
+    };
+    let (b, p) = ahead_rate(steps, k);
+    change(last, k) * b.powf(p) / (b.powf(p) - 1.0)
+}
+
+/// One step's change of mode k, never negative (infinite when the mode is missing).
+fn change(s: &Step, k: usize) -> f64 {
+    s.change.get(k).map_or(f64::INFINITY, |v| v.max(0.0))
+}
+
+/// The growth b of a family's last (forward) step and the rate p of [`ahead_of`].
+fn ahead_rate(steps: &[Step], k: usize) -> (f64, f64) {
+    let Some(last) = steps.last() else {
+        return (GROWTH, RATE_MIN);
+    };
+    let b = last.to as f64 / last.from as f64;
+    let before = steps[..steps.len() - 1]
+        .iter()
+        .rev()
+        .find(|s| s.to == last.from);
+    let p = before.map_or(RATE_MIN, |s1| {
+        fitted_rate(
+            s1.to as f64 / s1.from as f64,
+            b,
+            change(s1, k),
+            change(last, k),
+        )
+    });
+    (b, p)
+}
+
 /// The rate p with (a^p − 1) b^p / (b^p − 1) = d₁/d₂ (increasing in p), by bisection on
 /// [`RATE_MIN`, `RATE_MAX`]; the bounds when the ratio lies outside.
 pub fn fitted_rate(a: f64, b: f64, d1: f64, d2: f64) -> f64 {
@@ -335,12 +455,35 @@ pub fn fitted_rate(a: f64, b: f64, d1: f64, d2: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// A plate's joint forward step: both its directions one refinement up at once. The
+/// tensor-product functions that only the joint step adds (new length × new width) carry a
+/// share of the error that neither direction's own step sees — on the composite spacecraft
+/// as much as the two single steps together — so a plate's error is estimated from this step.
+#[derive(Debug, Clone)]
+struct Joint {
+    /// Every family's count when it was measured (the next level if both are refined).
+    at: Vec<usize>,
+    /// The plate's (length, width) counts when it was measured.
+    plate: (usize, usize),
+    /// ω with both directions one refinement up, and the eigenvectors.
+    omega: Vec<f64>,
+    vectors: Vectors,
+    /// The change of every wanted ω (rad/s).
+    change: Vec<f64>,
+}
+
+/// A forward solve: every family's count it was made at, ω and the eigenvectors.
+type Ahead = (Vec<usize>, Vec<f64>, Vectors);
+
 /// The selection's state: counts, ceiling, steps per family.
 struct Selector<'a> {
     accuracy: &'a Accuracy,
     structure: Structure,
     families: Vec<(Family, bool)>,
     steps: Vec<Vec<Step>>,
+    /// Per family: its steps are forward ones (n → n′ from the current count), not the last
+    /// two refinements that led to it.
+    forward: Vec<bool>,
     exhausted: Vec<bool>,
     /// Per family: the round its steps were last measured, the round its count last changed.
     measured_at: Vec<usize>,
@@ -348,11 +491,128 @@ struct Selector<'a> {
     round: usize,
     ceiling: Ceiling,
     omega: Vec<f64>,
+    /// The current level's eigenvectors (each solve starts from them).
+    vectors: Vectors,
+    /// Per family: its last forward solve, ω with that family one refinement up from the
+    /// counts (of every family) it was made at — the next level if that family is refined.
+    ahead: Vec<Option<Ahead>>,
+    /// Per plate family pair, at the length family's index: the last joint step.
+    joint: Vec<Option<Joint>>,
     solves: usize,
     assemblies: usize,
 }
 
 impl Selector<'_> {
+    /// Every family's count at the current level.
+    fn counts(&self) -> Vec<usize> {
+        self.families
+            .iter()
+            .map(|(f, _)| f.count(&self.structure))
+            .collect()
+    }
+
+    /// True when family `i`'s error is measured forward: automatic, and one refinement up
+    /// from its count is within [`MAX_TERMS`] and `max_dof`.
+    fn forward_possible(&self, i: usize) -> bool {
+        let f = self.families[i].0;
+        self.families[i].1
+            && finer(f.count(&self.structure)).is_some_and(|m| {
+                let mut st = self.structure.clone();
+                f.set(&mut st, m);
+                dof(&st) <= self.accuracy.max_dof
+            })
+    }
+
+    /// Measures family `i`'s error forward: one solve with it one refinement up, the step
+    /// n → n′ appended to its steps (the earlier steps give the rate).
+    fn measure_ahead(&mut self, i: usize) -> Result<(), RitzError> {
+        let f = self.families[i].0;
+        let n = f.count(&self.structure);
+        let m = finer(n).expect("forward_possible");
+        let (fine, vectors) = self.solve_with(f, m)?;
+        let s = step(n, m, &self.omega, &fine);
+        if self.forward[i] {
+            self.steps[i].push(s);
+        } else {
+            self.steps[i] = vec![s];
+            self.forward[i] = true;
+        }
+        self.ahead[i] = Some((self.counts(), fine, vectors));
+        self.measured_at[i] = self.round;
+        Ok(())
+    }
+
+    /// Measures family `i`'s error at the current counts: forward when possible, else from
+    /// two coarser sub-blocks.
+    fn measure(&mut self, i: usize) -> Result<(), RitzError> {
+        if self.forward_possible(i) {
+            self.measure_ahead(i)?;
+            if let Some((l, w)) = self.plate_pair(i) {
+                if self.forward_possible(l) && self.forward_possible(w) {
+                    self.measure_joint(l, w)?;
+                }
+            }
+            Ok(())
+        } else {
+            self.remeasure(i)
+        }
+    }
+
+    /// The (length, width) family indices of family `i`'s plate when both are automatic.
+    fn plate_pair(&self, i: usize) -> Option<(usize, usize)> {
+        let (Family::Length(p) | Family::Width(p)) = self.families[i].0 else {
+            return None;
+        };
+        let l = self
+            .families
+            .iter()
+            .position(|(f, _)| *f == Family::Length(p))?;
+        let w = self
+            .families
+            .iter()
+            .position(|(f, _)| *f == Family::Width(p))?;
+        (self.families[l].1 && self.families[w].1).then_some((l, w))
+    }
+
+    /// The plate's (length, width) counts at the current level.
+    fn plate_counts(&self, l: usize, w: usize) -> (usize, usize) {
+        (
+            self.families[l].0.count(&self.structure),
+            self.families[w].0.count(&self.structure),
+        )
+    }
+
+    /// Measures a plate's joint step unless it is already measured at the current counts.
+    fn measure_joint(&mut self, l: usize, w: usize) -> Result<(), RitzError> {
+        let counts = self.counts();
+        if self.joint[l].as_ref().is_some_and(|j| j.at == counts) {
+            return Ok(());
+        }
+        let (fl, fw) = (self.families[l].0, self.families[w].0);
+        let plate = self.plate_counts(l, w);
+        let (nl, nw) = (finer(plate.0), finer(plate.1));
+        let (Some(nl), Some(nw)) = (nl, nw) else {
+            return Ok(());
+        };
+        let mut st = self.structure.clone();
+        fl.set(&mut st, nl);
+        fw.set(&mut st, nw);
+        if dof(&st) > self.accuracy.max_dof {
+            return Ok(());
+        }
+        let (omega, vectors) = self.solve_at(&[(fl, nl), (fw, nw)])?;
+        let len = self.omega.len().min(omega.len());
+        let change = (0..len).map(|k| self.omega[k] - omega[k]).collect();
+        self.joint[l] = Some(Joint {
+            at: counts,
+            plate,
+            omega,
+            vectors,
+            change,
+        });
+        Ok(())
+    }
+
     fn automatic(&self) -> Vec<Family> {
         self.families
             .iter()
@@ -362,25 +622,29 @@ impl Selector<'_> {
     }
 
     /// ω of the structure with one family's count changed (the ceiling grown if needed).
-    fn solve_with(&mut self, family: Family, n: usize) -> Result<Vec<f64>, RitzError> {
+    fn solve_with(&mut self, family: Family, n: usize) -> Result<(Vec<f64>, Vectors), RitzError> {
+        self.solve_at(&[(family, n)])
+    }
+
+    /// ω of the structure with some families' counts changed (the ceiling grown if needed).
+    fn solve_at(&mut self, changes: &[(Family, usize)]) -> Result<(Vec<f64>, Vectors), RitzError> {
         let mut st = self.structure.clone();
-        family.set(&mut st, n);
+        for &(family, n) in changes {
+            family.set(&mut st, n);
+        }
         let auto = self.automatic();
         if !self.ceiling.covers(&st, &auto) {
-            // Grow the outgrown families two refinements beyond the need (one, or none, where
-            // that would pass max_dof), keep the rest.
+            // Grow the outgrown families one refinement beyond the need (none where that
+            // would pass max_dof), keep the rest: the next level's forward steps fit.
             let mut top = self.ceiling.model.structure.clone();
             for f in &auto {
                 let need = f.count(&st);
                 if need > f.count(&top) {
-                    let room = [finer(need).and_then(finer), finer(need)]
-                        .into_iter()
-                        .flatten()
-                        .find(|&g| {
-                            let mut t = top.clone();
-                            f.set(&mut t, g);
-                            dof(&t) <= self.accuracy.max_dof
-                        });
+                    let room = [finer(need)].into_iter().flatten().find(|&g| {
+                        let mut t = top.clone();
+                        f.set(&mut t, g);
+                        dof(&t) <= self.accuracy.max_dof
+                    });
                     f.set(&mut top, room.unwrap_or(need));
                 }
             }
@@ -388,16 +652,77 @@ impl Selector<'_> {
             self.assemblies += 1;
         }
         self.solves += 1;
-        self.ceiling.frequencies(&st, self.accuracy.modes)
+        self.ceiling
+            .frequencies(&st, self.accuracy.modes, Some(&self.vectors))
     }
 
     /// Estimated error of every wanted mode, per family (absolute, rad/s).
     fn errors(&self) -> Vec<Vec<f64>> {
-        self.steps
-            .iter()
-            .map(|s| {
+        let mut errors = self.single_errors();
+        for l in 0..self.families.len() {
+            if !matches!(self.families[l].0, Family::Length(_)) {
+                continue;
+            }
+            let Some((l, w)) = self.plate_pair(l) else {
+                continue;
+            };
+            let fresh = |i: usize| {
+                self.forward[i]
+                    && !self.stale(i)
+                    && self.steps[i]
+                        .last()
+                        .is_some_and(|s| s.from == self.families[i].0.count(&self.structure))
+            };
+            if !fresh(l) || !fresh(w) {
+                continue;
+            }
+            let Some(j) = (self.joint[l].as_ref()).filter(|j| j.plate == self.plate_counts(l, w))
+            else {
+                // No joint step (it would pass max_dof): the corner's share taken as large
+                // as the single steps' together, as measured on the composite spacecraft.
+                for k in 0..self.omega.len() {
+                    errors[l][k] *= CORNER;
+                    errors[w][k] *= CORNER;
+                }
+                continue;
+            };
+            for k in 0..self.omega.len() {
+                // The joint step's remaining error, with the slower of the two directions'
+                // rates and the length's growth.
+                let (b, pl) = ahead_rate(&self.steps[l], k);
+                let (_, pw) = ahead_rate(&self.steps[w], k);
+                let p = pl.min(pw);
+                let d = j.change.get(k).map_or(f64::INFINITY, |v| v.max(0.0));
+                let joint = FORWARD_SAFETY * d * b.powf(p) / (b.powf(p) - 1.0);
+                let (el, ew) = (errors[l][k], errors[w][k]);
+                let sum = el + ew;
+                if joint > sum {
+                    // Shared out in the proportion of the single steps (evenly if both vanish).
+                    let (sl, sw) = if sum > 0.0 {
+                        (el / sum, ew / sum)
+                    } else {
+                        (0.5, 0.5)
+                    };
+                    errors[l][k] = joint * sl;
+                    errors[w][k] = joint * sw;
+                }
+            }
+        }
+        errors
+    }
+
+    /// Every family's own estimate (absolute, rad/s), before a plate's joint step.
+    fn single_errors(&self) -> Vec<Vec<f64>> {
+        (self.steps.iter().zip(&self.forward))
+            .map(|(s, &fwd)| {
                 (0..self.omega.len())
-                    .map(|k| SAFETY * remaining(s, k))
+                    .map(|k| {
+                        if fwd {
+                            FORWARD_SAFETY * ahead_of(s, k)
+                        } else {
+                            SAFETY * remaining(s, k)
+                        }
+                    })
                     .collect()
             })
             .collect()
@@ -431,13 +756,49 @@ impl Selector<'_> {
                 self.exhausted[i] = true;
                 continue;
             }
-            let omega = self.solve_with(f, m)?;
-            self.record(i, n, m, &omega);
+            let counts = self.counts();
+            // A plate whose other direction leaves at least half this one's error: both
+            // directions at once (the joint step's solve is that level).
+            if let Some((l, w)) = self.plate_pair(i) {
+                let other = if i == l { w } else { l };
+                let g = self.families[other].0;
+                let worst = |e: &[f64]| {
+                    (e.iter().zip(&self.omega))
+                        .map(|(e, w)| e / w)
+                        .fold(0.0_f64, |a, b| if b.is_nan() { a } else { a.max(b) })
+                };
+                let both =
+                    worst(&errors[other]) >= 0.5 * worst(&errors[i]) && !self.exhausted[other];
+                if let Some(mg) = finer(g.count(&self.structure)).filter(|_| both) {
+                    let mut st2 = st.clone();
+                    g.set(&mut st2, mg);
+                    if dof(&st2) <= self.accuracy.max_dof {
+                        let (omega, vectors) = match self.joint[l].take() {
+                            Some(j) if j.at == counts => (j.omega, j.vectors),
+                            _ => self.solve_at(&[(f, m), (g, mg)])?,
+                        };
+                        self.structure = st2;
+                        self.omega = omega;
+                        self.vectors = vectors;
+                        self.round += 1;
+                        self.refined_at[i] = self.round;
+                        self.refined_at[other] = self.round;
+                        self.measure(i)?;
+                        self.measure(other)?;
+                        return Ok(true);
+                    }
+                }
+            }
+            let (omega, vectors) = match self.ahead[i].take() {
+                Some((at, w, v)) if at == counts => (w, v),
+                _ => self.solve_with(f, m)?,
+            };
             self.structure = st;
             self.omega = omega;
+            self.vectors = vectors;
             self.round += 1;
             self.refined_at[i] = self.round;
-            self.measured_at[i] = self.round;
+            self.measure(i)?;
             return Ok(true);
         }
         Ok(false)
@@ -462,14 +823,15 @@ impl Selector<'_> {
         let n2 = f.count(&self.structure);
         let mut steps = Vec::new();
         if let Some(n1) = coarser(n2) {
-            let w1 = self.solve_with(f, n1)?;
+            let w1 = self.solve_with(f, n1)?.0;
             if let Some(n0) = coarser(n1) {
-                let w0 = self.solve_with(f, n0)?;
+                let w0 = self.solve_with(f, n0)?.0;
                 steps.push(step(n0, n1, &w0, &w1));
             }
             steps.push(step(n1, n2, &w1, &self.omega));
         }
         self.steps[i] = steps;
+        self.forward[i] = false;
         self.measured_at[i] = self.round;
         Ok(())
     }
@@ -480,14 +842,9 @@ impl Selector<'_> {
             .filter(|&i| self.stale(i))
             .collect();
         for &i in &stale {
-            self.remeasure(i)?;
+            self.measure(i)?;
         }
         Ok(!stale.is_empty())
-    }
-
-    fn record(&mut self, i: usize, from: usize, to: usize, finer_omega: &[f64]) {
-        let s = step(from, to, &self.omega, finer_omega);
-        self.steps[i].push(s);
     }
 
     /// Relative estimate of every wanted mode: Σ over families.
@@ -555,27 +912,30 @@ pub fn select_terms(
         top = st.clone();
     }
     let ceiling = Ceiling::new(&top);
-    let omega = ceiling.frequencies(&st, accuracy.modes)?;
+    let (omega, vectors) = ceiling.frequencies(&st, accuracy.modes, None)?;
     let n = families.len();
     let mut sel = Selector {
         accuracy,
         structure: st,
         families,
         steps: vec![Vec::new(); n],
+        forward: vec![false; n],
         exhausted: vec![false; n],
         measured_at: vec![0; n],
         refined_at: vec![0; n],
         round: 0,
         ceiling,
         omega,
+        vectors,
+        ahead: vec![None; n],
+        joint: vec![None; n],
         solves: 1,
         assemblies: 1,
     };
-    // Given families: two coarser levels of the same model (sub-blocks, no re-assembly).
+    // Automatic families forward; given ones from two coarser levels of the same model
+    // (sub-blocks, no re-assembly).
     for i in 0..n {
-        if !sel.families[i].1 {
-            sel.remeasure(i)?;
-        }
+        sel.measure(i)?;
     }
     // Refine until the estimate is below the tolerance with every family measured at the
     // final counts of its component.

@@ -126,6 +126,17 @@ fn check_selection(
                 sel.solves,
                 ratios.join(" ")
             );
+            let kw = (0..count)
+                .max_by(|&a, &b| (sel.omega[a] / truth[a]).total_cmp(&(sel.omega[b] / truth[b])))
+                .unwrap();
+            eprintln!(
+                "   worst mode {kw}: true {:.2e} fams {:?}",
+                sel.omega[kw] / truth[kw] - 1.0,
+                sel.families
+                    .iter()
+                    .map(|f| (f.family, f.terms, format!("{:.2e}", f.error[kw])))
+                    .collect::<Vec<_>>()
+            );
             continue;
         }
         for k in 0..count {
