@@ -16,6 +16,7 @@
 use crate::basis::{Basis1d, Integrals};
 use crate::math::Vec3;
 use crate::structure::{Attachment, Beam, ComponentId, Plate, RigidBody, Structure};
+use faer::sparse::Triplet;
 use faer::Mat;
 
 /// Which field of a component's own coordinates a [`FieldRange`] holds.
@@ -210,6 +211,124 @@ fn layout(structure: &Structure) -> (Vec<Part<'_>>, usize) {
     (parts, n)
 }
 
+/// Where an assembly adds its entries: a dense matrix, or a list of triplets (for the
+/// eigen-solver's sparse matrices, without ever forming the dense ones).
+pub(crate) trait Sink {
+    /// a_ij += v.
+    fn add(&mut self, i: usize, j: usize, v: f64);
+}
+
+impl Sink for Mat<f64> {
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        self[(i, j)] += v;
+    }
+}
+
+/// Entries with their (row, column); zeros are skipped, and entries at the same place are
+/// summed when the matrix is built from them.
+impl Sink for Vec<Triplet<usize, usize, f64>> {
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        if v != 0.0 {
+            self.push(Triplet::new(i, j, v));
+        }
+    }
+}
+
+/// A sink shifted by (r0, c0).
+struct Offset<'a, S: Sink> {
+    sink: &'a mut S,
+    r0: usize,
+    c0: usize,
+}
+
+impl<S: Sink> Sink for Offset<'_, S> {
+    fn add(&mut self, i: usize, j: usize, v: f64) {
+        self.sink.add(self.r0 + i, self.c0 + j, v);
+    }
+}
+
+/// The mass and stiffness matrices of a structure (unsymmetrised: M_ij and M_ji may differ
+/// in the last bit) and its components' elements.
+pub(crate) fn assemble_into<S: Sink>(
+    structure: &Structure,
+    mass: &mut S,
+    stiffness: &mut S,
+) -> Vec<Element> {
+    // Own-coordinate layout first, so that every T has its final width.
+    let (parts, n) = layout(structure);
+    let hub = &structure.hub;
+    let hub_t = hub_map(n, hub.center_of_mass, hub.center_of_mass);
+    add_rigid(mass, &hub_t, &hub.rigid_body());
+    let mut elements = vec![Element {
+        id: ComponentId::Hub,
+        fields: Vec::new(),
+        attachment: hub_t,
+        origin: hub.center_of_mass,
+        kind: ElementKind::Rigid,
+    }];
+    // Root map of every beam, filled in topological order.
+    let mut beam_elem: Vec<Option<usize>> = vec![None; structure.beams.len()];
+
+    for part in parts {
+        let att = part.attachment;
+        let origin = structure.attachment_point(att);
+        let t = match att {
+            Attachment::Hub { point } => hub_map(n, *point, hub.center_of_mass),
+            Attachment::Beam { beam, station } => {
+                let bi = *beam;
+                let pe = &elements[beam_elem[bi].expect("parents come first")];
+                section_map(&structure.beams[bi], pe, *station, n)
+            }
+        };
+        let own = part.fields.first().map_or(0, |f| f.start);
+        match &part.kind {
+            ElementKind::Beam {
+                index,
+                axial,
+                bending,
+                torsion,
+            } => {
+                let (me, ke) = beam_element(
+                    &structure.beams[*index],
+                    axial.as_ref(),
+                    bending.as_ref(),
+                    torsion.as_ref(),
+                );
+                add_element(mass, stiffness, &t, own, &me, &ke);
+                beam_elem[*index] = Some(elements.len());
+            }
+            ElementKind::Plate {
+                index,
+                length,
+                width,
+            } => {
+                let (rigid, coupling) = plate_element_into(
+                    &structure.plates[*index],
+                    length.as_ref(),
+                    width.as_ref(),
+                    &mut Offset {
+                        sink: &mut *mass,
+                        r0: own,
+                        c0: own,
+                    },
+                    &mut Offset {
+                        sink: &mut *stiffness,
+                        r0: own,
+                        c0: own,
+                    },
+                );
+                add_coupling(mass, &t, own, &rigid, &coupling);
+            }
+            ElementKind::Rigid => {}
+        }
+        if let Some(rb) = &part.lumped {
+            add_rigid(mass, &t, rb);
+        }
+        elements.push(Element::new(part, t, origin));
+    }
+    elements
+}
+
 /// The assembled Ritz model: K q = ω² M q.
 #[derive(Debug)]
 pub struct RitzModel {
@@ -234,67 +353,10 @@ impl RitzModel {
 
     /// Assembles M and K of a structure with its chosen basis.
     pub fn assemble(structure: &Structure) -> Self {
-        // Own-coordinate layout first, so that every T has its final width.
-        let (parts, n) = layout(structure);
+        let n = layout(structure).1;
         let mut mass = Mat::<f64>::zeros(n, n);
         let mut stiffness = Mat::<f64>::zeros(n, n);
-        let hub = &structure.hub;
-        let hub_t = hub_map(n, hub.center_of_mass, hub.center_of_mass);
-        add_rigid(&mut mass, &hub_t, &hub.rigid_body());
-        let mut elements = vec![Element {
-            id: ComponentId::Hub,
-            fields: Vec::new(),
-            attachment: hub_t,
-            origin: hub.center_of_mass,
-            kind: ElementKind::Rigid,
-        }];
-        // Root map of every beam, filled in topological order.
-        let mut beam_elem: Vec<Option<usize>> = vec![None; structure.beams.len()];
-
-        for part in parts {
-            let att = part.attachment;
-            let origin = structure.attachment_point(att);
-            let t = match att {
-                Attachment::Hub { point } => hub_map(n, *point, hub.center_of_mass),
-                Attachment::Beam { beam, station } => {
-                    let bi = *beam;
-                    let pe = &elements[beam_elem[bi].expect("parents come first")];
-                    section_map(&structure.beams[bi], pe, *station, n)
-                }
-            };
-            let own = part.fields.first().map_or(0, |f| f.start);
-            match &part.kind {
-                ElementKind::Beam {
-                    index,
-                    axial,
-                    bending,
-                    torsion,
-                } => {
-                    let (me, ke) = beam_element(
-                        &structure.beams[*index],
-                        axial.as_ref(),
-                        bending.as_ref(),
-                        torsion.as_ref(),
-                    );
-                    add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
-                    beam_elem[*index] = Some(elements.len());
-                }
-                ElementKind::Plate {
-                    index,
-                    length,
-                    width,
-                } => {
-                    let (me, ke) =
-                        plate_element(&structure.plates[*index], length.as_ref(), width.as_ref());
-                    add_element(&mut mass, &mut stiffness, &t, own, &me, &ke);
-                }
-                ElementKind::Rigid => {}
-            }
-            if let Some(rb) = &part.lumped {
-                add_rigid(&mut mass, &t, rb);
-            }
-            elements.push(Element::new(part, t, origin));
-        }
+        let elements = assemble_into(structure, &mut mass, &mut stiffness);
         symmetrize(&mut mass);
         symmetrize(&mut stiffness);
         Self {
@@ -570,6 +632,41 @@ pub(crate) fn plate_element(
     xb: &dyn Basis1d,
     yb: &dyn Basis1d,
 ) -> (Mat<f64>, Mat<f64>) {
+    let ne = xb.len() * yb.len();
+    let mut me = Mat::zeros(6 + ne, 6 + ne);
+    let mut ke = Mat::zeros(ne, ne);
+    let (rigid, coupling) = plate_element_into(
+        plate,
+        xb,
+        yb,
+        &mut Offset {
+            sink: &mut me,
+            r0: 6,
+            c0: 6,
+        },
+        &mut ke,
+    );
+    for i in 0..6 {
+        for j in 0..6 {
+            me[(i, j)] = rigid[(i, j)];
+        }
+        for c in 0..ne {
+            me[(i, 6 + c)] = coupling[(i, c)];
+            me[(6 + c, i)] = coupling[(i, c)];
+        }
+    }
+    (me, ke)
+}
+
+/// [`plate_element`] with the own blocks M_oo and K_oo added into sinks; returns the rigid
+/// block M_rr (6 × 6) and the coupling M_ro (6 × n_e).
+fn plate_element_into(
+    plate: &Plate,
+    xb: &dyn Basis1d,
+    yb: &dyn Basis1d,
+    own_mass: &mut impl Sink,
+    own_stiffness: &mut impl Sink,
+) -> (Mat<f64>, Mat<f64>) {
     let (nx, ny) = (xb.len(), yb.len());
     let ne = nx * ny;
     let (a, b) = (plate.length, plate.width);
@@ -577,20 +674,20 @@ pub(crate) fn plate_element(
     let (d, nu) = (plate.bending_stiffness, plate.poisson_ratio);
     let (ix, iy) = (Integrals::new(xb), Integrals::new(yb));
     let (ea, eb, nn) = (plate.length_axis, plate.width_axis(), plate.normal);
-    let mut me = rigid_block(&plate.rigid_body(), ne);
-    let mut ke = Mat::zeros(ne, ne);
+    let rigid = rigid_block(&plate.rigid_body(), 0);
+    let mut coupling = Mat::zeros(6, ne);
     let area = a * b;
     for m in 0..nx {
         for n in 0..ny {
             let k = m * ny + n;
             let mean_x = a * ix.m1[m] * iy.m0[n];
             let mean_y = ix.m0[m] * b * (iy.m1[n] - 0.5 * iy.m0[n]);
-            set_coupling(
-                &mut me,
-                6 + k,
-                nn * (mu * area * ix.m0[m] * iy.m0[n]),
-                (eb * -mean_x + ea * mean_y) * (mu * area),
-            );
+            let du = nn * (mu * area * ix.m0[m] * iy.m0[n]);
+            let dth = (eb * -mean_x + ea * mean_y) * (mu * area);
+            for i in 0..3 {
+                coupling[(i, k)] = du.get(i);
+                coupling[(3 + i, k)] = dth.get(i);
+            }
         }
     }
     let (a2b2, a4, b4) = (a * a * b * b, a.powi(4), b.powi(4));
@@ -614,23 +711,23 @@ pub(crate) fn plate_element(
     };
     let (px, py) = (pairs(&ix, nx), pairs(&iy, ny));
     for &(m, p) in &px {
-        {
-            for &(n, q) in &py {
+        for &(n, q) in &py {
+            {
                 {
                     let (k, l) = (m * ny + n, p * ny + q);
-                    me[(6 + k, 6 + l)] = mu * area * ix.i00[(m, p)] * iy.i00[(n, q)];
+                    own_mass.add(k, l, mu * area * ix.i00[(m, p)] * iy.i00[(n, q)]);
                     let kxx = ix.i22[(m, p)] * iy.i00[(n, q)] / a4;
                     let kyy = ix.i00[(m, p)] * iy.i22[(n, q)] / b4;
                     let kxy = nu
                         * (ix.i20[(m, p)] * iy.i20[(q, n)] + ix.i20[(p, m)] * iy.i20[(n, q)])
                         / a2b2;
                     let ktw = 2.0 * (1.0 - nu) * ix.i11[(m, p)] * iy.i11[(n, q)] / a2b2;
-                    ke[(k, l)] = d * area * (kxx + kyy + kxy + ktw);
+                    own_stiffness.add(k, l, d * area * (kxx + kyy + kxy + ktw));
                 }
             }
         }
     }
-    (me, ke)
+    (rigid, coupling)
 }
 
 /// The columns of a 6 × n map T that are not all zero: the hub's coordinates and the
@@ -645,48 +742,61 @@ fn support(t: &Mat<f64>) -> (Vec<usize>, Mat<f64>) {
 }
 
 /// M += Tᵀ B T for a rigid body's 6×6 block B.
-fn add_rigid(mass: &mut Mat<f64>, t: &Mat<f64>, rb: &RigidBody) {
+fn add_rigid(mass: &mut impl Sink, t: &Mat<f64>, rb: &RigidBody) {
     let b = rigid_block(rb, 0);
     let (cols, ts) = support(t);
     let tbt = ts.transpose() * (&b * &ts);
     for (b, &j) in cols.iter().enumerate() {
         for (a, &i) in cols.iter().enumerate() {
-            mass[(i, j)] += tbt[(a, b)];
+            mass.add(i, j, tbt[(a, b)]);
         }
     }
 }
 
-/// M += Bᵀ M_e B and K[own, own] += K_e with B = [T; P_own].
+/// M += Bᵀ M_e B and K[own, own] += K_e with B = [T; P_own], for dense element matrices.
 fn add_element(
-    mass: &mut Mat<f64>,
-    stiffness: &mut Mat<f64>,
+    mass: &mut impl Sink,
+    stiffness: &mut impl Sink,
     t: &Mat<f64>,
     own: usize,
     me: &Mat<f64>,
     ke: &Mat<f64>,
 ) {
     let ne = ke.nrows();
-    let (cols, ts) = support(t);
-    let mrr = me.submatrix(0, 0, 6, 6);
-    let mro = me.submatrix(0, 6, 6, ne);
-    let tbt = ts.transpose() * (mrr * &ts);
-    for (b, &j) in cols.iter().enumerate() {
-        for (a, &i) in cols.iter().enumerate() {
-            mass[(i, j)] += tbt[(a, b)];
+    let rigid = me.submatrix(0, 0, 6, 6).to_owned();
+    let coupling = me.submatrix(0, 6, 6, ne).to_owned();
+    add_coupling(mass, t, own, &rigid, &coupling);
+    for j in 0..ne {
+        for i in 0..ne {
+            mass.add(own + i, own + j, me[(6 + i, 6 + j)]);
+            stiffness.add(own + i, own + j, ke[(i, j)]);
         }
     }
-    let tro = ts.transpose() * mro; // |support| × ne
+}
+
+/// The parts of Bᵀ M_e B that involve the attachment's rigid motion: Tᵀ M_rr T and the
+/// couplings Tᵀ M_ro, (Tᵀ M_ro)ᵀ, over the support of T only.
+fn add_coupling(
+    mass: &mut impl Sink,
+    t: &Mat<f64>,
+    own: usize,
+    rigid: &Mat<f64>,
+    coupling: &Mat<f64>,
+) {
+    let ne = coupling.ncols();
+    let (cols, ts) = support(t);
+    let tbt = ts.transpose() * (rigid * &ts);
+    for (b, &j) in cols.iter().enumerate() {
+        for (a, &i) in cols.iter().enumerate() {
+            mass.add(i, j, tbt[(a, b)]);
+        }
+    }
+    let tro = ts.transpose() * coupling; // |support| × ne
     for c in 0..ne {
         for (a, &i) in cols.iter().enumerate() {
             let v = tro[(a, c)];
-            mass[(i, own + c)] += v;
-            mass[(own + c, i)] += v;
-        }
-    }
-    for j in 0..ne {
-        for i in 0..ne {
-            mass[(own + i, own + j)] += me[(6 + i, 6 + j)];
-            stiffness[(own + i, own + j)] += ke[(i, j)];
+            mass.add(i, own + c, v);
+            mass.add(own + c, i, v);
         }
     }
 }

@@ -4,7 +4,7 @@ use super::RitzError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::matmul::sparse_dense_matmul;
 use faer::sparse::linalg::solvers::Llt as SparseLlt;
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 use faer::{Accum, Mat, Par, Side};
 
 /// Solves K φ = λ M φ for symmetric K and symmetric positive definite M.
@@ -216,6 +216,37 @@ impl Operator {
         }
     }
 
+    /// The sub-matrix of rows and columns `idx` (strictly increasing), in that order.
+    pub fn select(&self, idx: &[usize]) -> Self {
+        debug_assert!(idx.windows(2).all(|w| w[0] < w[1]));
+        match self {
+            Self::Dense(d) => Self::Dense(Mat::from_fn(idx.len(), idx.len(), |i, j| {
+                d[(idx[i], idx[j])]
+            })),
+            Self::Sparse(a) => {
+                let mut pos = vec![usize::MAX; a.nrows()];
+                for (new, &old) in idx.iter().enumerate() {
+                    pos[old] = new;
+                }
+                let (mut col_ptr, mut rows, mut vals) = (vec![0], Vec::new(), Vec::new());
+                for &j in idx {
+                    let (r, v) = (a.row_idx_of_col_raw(j), a.val_of_col(j));
+                    for (&i, &x) in r.iter().zip(v) {
+                        if pos[i] != usize::MAX {
+                            rows.push(pos[i]);
+                            vals.push(x);
+                        }
+                    }
+                    col_ptr.push(rows.len());
+                }
+                // Increasing idx keeps every column's rows sorted.
+                let n = idx.len();
+                let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+                Self::Sparse(SparseColMat::new(symbolic, vals))
+            }
+        }
+    }
+
     /// The whole matrix, dense.
     fn to_dense(&self) -> Mat<f64> {
         match self {
@@ -256,14 +287,39 @@ impl ShiftInvert {
     fn new(k: &Operator, m: &Operator, s: f64) -> Option<Self> {
         let n = k.order();
         match (k, m) {
-            (Operator::Sparse(_), Operator::Sparse(_)) => {
-                let t: Vec<_> = (k.entries().into_iter())
-                    .chain(m.entries().into_iter().map(|(i, j, v)| (i, j, s * v)))
-                    .filter(|&(i, j, _)| i >= j)
-                    .map(|(i, j, v)| Triplet::new(i, j, v))
-                    .collect();
-                // (Duplicate entries are summed.)
-                let a = SparseColMat::try_new_from_triplets(n, n, &t).ok()?;
+            (Operator::Sparse(ks), Operator::Sparse(ms)) => {
+                // The lower triangle of K + sM, column by column (both columns' rows are
+                // sorted: a merge).
+                let (mut col_ptr, mut rows, mut vals) = (vec![0], Vec::new(), Vec::new());
+                for j in 0..n {
+                    let (kr, kv) = (ks.row_idx_of_col_raw(j), ks.val_of_col(j));
+                    let (mr, mv) = (ms.row_idx_of_col_raw(j), ms.val_of_col(j));
+                    let (mut a, mut b) = (
+                        kr.partition_point(|&i| i < j),
+                        mr.partition_point(|&i| i < j),
+                    );
+                    while a < kr.len() || b < mr.len() {
+                        let (ia, ib) = (
+                            kr.get(a).copied().unwrap_or(usize::MAX),
+                            mr.get(b).copied().unwrap_or(usize::MAX),
+                        );
+                        let i = ia.min(ib);
+                        let mut v = 0.0;
+                        if ia == i {
+                            v += kv[a];
+                            a += 1;
+                        }
+                        if ib == i {
+                            v += s * mv[b];
+                            b += 1;
+                        }
+                        rows.push(i);
+                        vals.push(v);
+                    }
+                    col_ptr.push(rows.len());
+                }
+                let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, rows);
+                let a = SparseColMat::new(symbolic, vals);
                 Some(Self::Sparse(a.sp_cholesky(Side::Lower).ok()?))
             }
             _ => {
@@ -390,6 +446,9 @@ pub fn lowest_with(
 ) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
     let n = m.nrows();
     let r = with.null_space.min(n);
+    if count.min(n - r) == 0 {
+        return Ok((Vec::new(), Mat::zeros(n, 0)));
+    }
     if dense_route(n, r, count) {
         return dense_lowest(k, m, r, count.min(n - r));
     }
@@ -434,6 +493,9 @@ pub fn lowest_of(
     let r = with.null_space.min(n);
     let count = count.min(n - r);
     let p = (2 * count + 8).min(n - r);
+    if count == 0 {
+        return Ok((Vec::new(), Mat::zeros(n, 0)));
+    }
     if dense_route(n, r, count) {
         return dense_lowest(&ko.to_dense(), &mo.to_dense(), r, count);
     }

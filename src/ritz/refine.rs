@@ -33,12 +33,11 @@
 //! passing `max_dof`. Families with explicit terms are never changed; their error is
 //! estimated by two coarser sub-blocks of the same model.
 
-use super::assembly::{ElementKind, FieldKind, RitzModel, HUB_DOF};
+use super::assembly::{assemble_into, Element, ElementKind, FieldKind, HUB_DOF};
 use super::eigen::{lowest_of, Lowest, Operator};
 use super::RitzError;
 use crate::structure::HubMotion;
 use crate::structure::{ComponentId, Structure, MAX_TERMS};
-use faer::sparse::Triplet;
 use faer::Mat;
 
 /// Slowest convergence rate assumed, in ω_k − ω_k,exact ≈ C n^(−p).
@@ -222,33 +221,39 @@ pub struct TermSelection {
 /// A model assembled at counts at least those of every level it serves: each level's
 /// matrices are an index selection of its own (the bases are hierarchical).
 struct Ceiling {
-    model: RitzModel,
-    /// The model's mass and stiffness matrices as the eigen-solver holds them.
+    /// The structure at the ceiling's counts and its elements.
+    structure: Structure,
+    elements: Vec<Element>,
+    /// The model's mass and stiffness matrices, assembled straight into the eigen-solver's
+    /// sparse form (the dense ones are never formed).
     mass: Operator,
     stiffness: Operator,
 }
 
 impl Ceiling {
     fn new(st: &Structure) -> Self {
-        let model = RitzModel::assemble(st);
+        let (mut m, mut k) = (Vec::new(), Vec::new());
+        let elements = assemble_into(st, &mut m, &mut k);
+        let n = dof(st);
         Self {
-            mass: Operator::from_dense(&model.mass),
-            stiffness: Operator::from_dense(&model.stiffness),
-            model,
+            structure: st.clone(),
+            elements,
+            mass: Operator::from_triplets(n, &m),
+            stiffness: Operator::from_triplets(n, &k),
         }
     }
 
     fn covers(&self, st: &Structure, families: &[Family]) -> bool {
         families
             .iter()
-            .all(|f| f.count(st) <= f.count(&self.model.structure))
+            .all(|f| f.count(st) <= f.count(&self.structure))
     }
 
     /// The global indices of `st`'s coordinates in the ceiling model, in `st`'s own order.
     fn indices(&self, st: &Structure) -> (Vec<usize>, Vec<Key>) {
         let mut idx: Vec<usize> = (0..HUB_DOF).collect();
         let mut keys: Vec<Key> = (0..HUB_DOF).map(|i| (0, 0, i)).collect();
-        for (ei, e) in self.model.elements.iter().enumerate() {
+        for (ei, e) in self.elements.iter().enumerate() {
             match e.kind {
                 ElementKind::Beam { index, .. } => {
                     let t = st.beams[index].terms;
@@ -264,7 +269,7 @@ impl Ceiling {
                 }
                 ElementKind::Plate { index, .. } => {
                     let t = st.plates[index].terms;
-                    let full = self.model.structure.plates[index].terms.width;
+                    let full = self.structure.plates[index].terms.width;
                     let start = e.own_range().start;
                     for m in 0..t.length {
                         idx.extend((0..t.width).map(|w| start + m * full + w));
@@ -301,29 +306,14 @@ impl Ceiling {
             start: start.as_ref(),
         };
         let (lambda, values) = lowest_of(
-            &pick(&self.stiffness, idx, self.model.dof()),
-            &pick(&self.mass, idx, self.model.dof()),
+            &self.stiffness.select(idx),
+            &self.mass.select(idx),
             count,
             &with,
         )?;
         let omega = lambda.iter().map(|l| l.max(0.0).sqrt()).collect();
         Ok((omega, Vectors { keys, values }))
     }
-}
-
-/// The sub-matrix of rows and columns `idx` (in that order) of an n × n matrix.
-fn pick(a: &Operator, idx: &[usize], n: usize) -> Operator {
-    let mut pos = vec![usize::MAX; n];
-    for (new, &old) in idx.iter().enumerate() {
-        pos[old] = new;
-    }
-    let triplets: Vec<_> = a
-        .entries()
-        .into_iter()
-        .filter(|&(i, j, _)| pos[i] != usize::MAX && pos[j] != usize::MAX)
-        .map(|(i, j, v)| Triplet::new(pos[i], pos[j], v))
-        .collect();
-    Operator::from_triplets(idx.len(), &triplets)
 }
 
 /// A coordinate's identity across levels and ceilings: (element, field — or a plate's
@@ -636,7 +626,7 @@ impl Selector<'_> {
         if !self.ceiling.covers(&st, &auto) {
             // Grow the outgrown families one refinement beyond the need (none where that
             // would pass max_dof), keep the rest: the next level's forward steps fit.
-            let mut top = self.ceiling.model.structure.clone();
+            let mut top = self.ceiling.structure.clone();
             for f in &auto {
                 let need = f.count(&st);
                 if need > f.count(&top) {
