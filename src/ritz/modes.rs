@@ -14,7 +14,7 @@
 //! m_eff,i,d = (φ_iᵀ M_e,d)², whose sum over a complete basis is the appendages' rigid mass.
 
 use super::assembly::{ElementKind, RitzModel, HUB_DOF};
-use super::eigen::{generalized_symmetric, lowest, lowest_with, Lowest};
+use super::eigen::{lowest_of, Lowest, Operator};
 use super::RitzError;
 use crate::math::Vec3;
 use crate::structure::{Attachment, ComponentId, HubMotion, RigidBody};
@@ -133,13 +133,19 @@ impl ModalAnalysis {
         let ne = n - HUB_DOF;
         let m = &model.mass;
         let k = &model.stiffness;
-        let mee = m.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
-        let kee = k.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
         let mer = m.submatrix(HUB_DOF, 0, ne, HUB_DOF).to_owned();
         let mrr = m.submatrix(0, 0, HUB_DOF, HUB_DOF).to_owned();
         let wanted = count.map_or(ne, |c| c.min(ne));
-
-        let (lam_f, phi_f) = solve(&kee, &mee, wanted)?;
+        // The matrices as the eigen-solver holds them (sparse when they are), once; the
+        // hub-fixed pencil (K_ee, M_ee) is their elastic sub-block.
+        let (ko, mo) = (Operator::from_dense(k), Operator::from_dense(m));
+        let elastic: Vec<usize> = (HUB_DOF..n).collect();
+        let (lam_f, phi_f) = lowest_of(
+            &ko.select(&elastic),
+            &mo.select(&elastic),
+            wanted,
+            &Lowest::default(),
+        )?;
         let appendage_mass = appendage_mass(model, &mrr);
         let hub_fixed: Vec<HubFixedMode> = (0..wanted)
             .map(|j| {
@@ -184,7 +190,16 @@ impl ModalAnalysis {
             }
             HubMotion::Free => {
                 modes.extend(rigid_modes(model, &mrr));
-                for (lambda, shape) in free_elastic(m, k, wanted)? {
+                // The eigenpairs of (K, M) M-orthogonal to the six rigid-body ones (K is
+                // zero on the hub's coordinates): their hub coordinates follow from the
+                // elastic ones by the hub's momentum equation, q_r = −M_rr⁻¹ M_re q_e.
+                let with = Lowest {
+                    null_space: HUB_DOF,
+                    start: None,
+                };
+                let (lam, phi) = lowest_of(&ko, &mo, wanted, &with)?;
+                for (j, &lambda) in lam.iter().enumerate() {
+                    let shape = (0..n).map(|i| phi[(i, j)]).collect();
                     modes.push(elastic_mode(lambda, shape, None));
                 }
             }
@@ -249,37 +264,6 @@ impl ModalAnalysis {
             })
             .collect()
     }
-}
-
-/// The `count` lowest eigenpairs of (K, M): the partial solver when it saves work, the dense
-/// one otherwise.
-fn solve(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
-    if count < k.nrows() {
-        lowest(k, m, count)
-    } else {
-        generalized_symmetric(k, m)
-    }
-}
-
-/// The `count` lowest elastic modes of a free-hub model (hub's six coordinates first): ω²
-/// and the shape over all coordinates, ΦᵀMΦ = I: the eigenpairs of (K, M) M-orthogonal to
-/// the six rigid-body ones (K is zero on the hub's coordinates), whose hub coordinates
-/// follow from the elastic ones by the hub's momentum equation, q_r = −M_rr⁻¹ M_re q_e
-/// ([`lowest_with`] with the hub's null space).
-fn free_elastic(
-    m: &Mat<f64>,
-    k: &Mat<f64>,
-    count: usize,
-) -> Result<Vec<(f64, Vec<f64>)>, RitzError> {
-    let n = m.nrows();
-    let with = Lowest {
-        null_space: HUB_DOF,
-        start: None,
-    };
-    let (lam, phi) = lowest_with(k, m, count, &with)?;
-    Ok((0..lam.len())
-        .map(|j| (lam[j], (0..n).map(|i| phi[(i, j)]).collect()))
-        .collect())
 }
 
 /// Sign convention: the largest-magnitude coordinate is positive (deterministic output).
