@@ -17,21 +17,24 @@
 //! **Error model.** The error of ω_k is the sum of the families' truncation errors,
 //! e_k = Σ_F e_F,k(n_F), each algebraic in the count, e_F,k(n) ≈ C n^(−p) (the corner
 //! singularities of plates and the joints bound the rate; smooth components converge faster,
-//! and an algebraic model then over-estimates: the estimate stays on the safe side). From a
-//! family's last two refinements n₀ → n₁ → n₂ with changes d₁, d₂ the rate p solves
-//! d₁/d₂ = (a^p − 1) b^p / (b^p − 1), a = n₁/n₀, b = n₂/n₁ (a Richardson step with the rate
-//! fitted, clamped to [`RATE_MIN`, `RATE_MAX`]), and the remaining error is
-//! e = d₂ / (b^p − 1), times a safety factor [`SAFETY`]. With one refinement the slowest rate
-//! [`RATE_MIN`] is assumed. Because
-//! the frequencies converge from above, the estimate is one-sided: the true ω_k lies in
-//! [ω_k − e_k, ω_k].
+//! and an algebraic model then over-estimates: the estimate stays on the safe side). An
+//! automatic family's error is measured *forward* ([`ahead_of`]): one solve with the family
+//! one refinement up, n → n′ = b n, changes ω_k by D, and e = D b^p / (b^p − 1), the rate
+//! fitted from the step before ([`fitted_rate`], clamped to [`RATE_MIN`, `RATE_MAX`]).
+//! A plate's two directions are also refined together ([`Joint`]): the tensor-product
+//! functions new in both directions carry error neither single step sees. Families with
+//! given terms, and automatic ones that cannot grow, are measured *backward* ([`remaining`]):
+//! from the last two refinements n₀ → n₁ → n₂ with changes d₁, d₂, e = d₂ / (b^p − 1) times
+//! [`SAFETY`]. Because the frequencies converge from above, the estimate is one-sided: the
+//! true ω_k lies in [ω_k − e_k, ω_k].
 //!
-//! **Selection.** Start every automatic family small (enough functions for twice the wanted
-//! modes), then repeatedly refine (n → max(n + 1, ⌈1.5 n⌉)) the automatic family whose
-//! estimated error is the largest relative to its mode's frequency, until the sum of the
-//! estimates is below the tolerance for every wanted mode, or no family can grow without
-//! passing `max_dof`. Families with explicit terms are never changed; their error is
-//! estimated by two coarser sub-blocks of the same model.
+//! **Selection.** Start every automatic family small (enough functions for four coordinates
+//! per wanted mode), then repeatedly refine (n → max(n + 1, ⌈1.5 n⌉)) the automatic family
+//! whose estimated error is the largest relative to its mode's frequency — a plate's two
+//! directions together when both matter — until the sum of the estimates is below the
+//! tolerance for every wanted mode, or no family can grow without passing `max_dof`. A
+//! refined level's frequencies are those of the forward solve that measured it, and every
+//! solve starts from the current level's eigenvectors ([`Vectors`]).
 
 use super::assembly::{assemble_into, Element, ElementKind, FieldKind, HUB_DOF};
 use super::eigen::{lowest_of, Lowest, Operator};
