@@ -425,10 +425,19 @@ pub const LOWEST_MAX_ITERATIONS: usize = 400;
 /// is at most [`DENSE_BELOW`].
 /// Returns λ ascending and Φ (n × count) with ΦᵀMΦ = I.
 pub fn lowest(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
-    lowest_with(k, m, count, &Lowest::default())
+    let n = m.nrows();
+    if dense_route(n, 0, count) {
+        return dense_lowest(k, m, 0, count.min(n));
+    }
+    lowest_of(
+        &Operator::from_dense(k),
+        &Operator::from_dense(m),
+        count,
+        &Lowest::default(),
+    )
 }
 
-/// What [`lowest_with`] knows beyond the pencil.
+/// What [`lowest_of`] knows beyond the pencil.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Lowest<'a> {
     /// The first `null_space` coordinates span K's null space exactly (K's rows and
@@ -441,38 +450,7 @@ pub struct Lowest<'a> {
     pub start: Option<&'a Mat<f64>>,
 }
 
-/// [`lowest`] with a known null space deflated and an optional start.
-///
-/// The null space: every iterate is projected onto the M-orthogonal complement of the
-/// first r coordinates, X ← X − E M_rr⁻¹ (E ᵀ M X) (only X's first r rows change), after
-/// each shift-invert step (which would otherwise amplify the rigid-body directions by
-/// 1/s). The iteration then needs no room for the r zero eigenvalues. The dense route
-/// condenses them out instead: (K_ee, M_ee − M_er M_rr⁻¹ M_re) — never the whole singular
-/// pencil, whose M-Cholesky route loses the low modes' digits (1 % on the composite
-/// spacecraft's 434 coordinates).
-pub fn lowest_with(
-    k: &Mat<f64>,
-    m: &Mat<f64>,
-    count: usize,
-    with: &Lowest,
-) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
-    let n = m.nrows();
-    let r = with.null_space.min(n);
-    if count.min(n - r) == 0 {
-        return Ok((Vec::new(), Mat::zeros(n, 0)));
-    }
-    if dense_route(n, r, count) {
-        return dense_lowest(k, m, r, count.min(n - r));
-    }
-    lowest_of(
-        &Operator::from_dense(k),
-        &Operator::from_dense(m),
-        count,
-        with,
-    )
-}
-
-/// True when [`lowest_with`] solves densely.
+/// True when [`lowest_of`] solves densely.
 fn dense_route(n: usize, r: usize, count: usize) -> bool {
     let count = count.min(n - r);
     let p = (2 * count + 8).min(n - r);
@@ -494,7 +472,16 @@ fn dense_lowest(
     }
 }
 
-/// [`lowest_with`] for a pencil already held as [`Operator`]s.
+/// [`lowest`] for a pencil held as [`Operator`]s, with a known null space deflated and an
+/// optional start.
+///
+/// The null space: every iterate is projected onto the M-orthogonal complement of the
+/// first r coordinates, X ← X − E M_rr⁻¹ (E ᵀ M X) (only X's first r rows change), after
+/// each shift-invert step (which would otherwise amplify the rigid-body directions by
+/// 1/s). The iteration then needs no room for the r zero eigenvalues. The dense route
+/// condenses them out instead: (K_ee, M_ee − M_er M_rr⁻¹ M_re) — never the whole singular
+/// pencil, whose M-Cholesky route loses the low modes' digits (1 % on the composite
+/// spacecraft's 434 coordinates).
 pub fn lowest_of(
     ko: &Operator,
     mo: &Operator,
@@ -624,7 +611,7 @@ pub fn lowest_of(
     Err(RitzError::EigenNoConvergence)
 }
 
-/// The dense route of [`lowest_with`] with a null space of the first r coordinates: the
+/// The dense route of [`lowest_of`] with a null space of the first r coordinates: the
 /// pencil (K_ee, M̃), M̃ = M_ee − M_er X, X = M_rr⁻¹ M_re, and q_r = −X q_e.
 fn condensed(
     k: &Mat<f64>,

@@ -126,7 +126,7 @@ impl ModalAnalysis {
 
     /// Solves for the `count` lowest elastic modes only (all of them for `None`, or when
     /// `count` is not well below the number of coordinates), by
-    /// [`super::eigen::lowest`]: the fast route when a run needs ten modes of a model with a
+    /// [`super::eigen::lowest_of`]: the fast route when a run needs ten modes of a model with a
     /// thousand coordinates. The hub-fixed list (effective masses) is cut to the same count.
     pub fn compute_lowest(model: &RitzModel, count: Option<usize>) -> Result<Self, RitzError> {
         let n = model.dof();
