@@ -59,7 +59,10 @@ fn bench(c: &mut Criterion) {
                         .expect("composite");
                     let model = RitzModel::assemble(&s.structure);
                     let sel = s.term_selection.as_ref().map(|t| t.accuracy.modes);
-                    black_box(ModalAnalysis::compute_lowest(&model, sel).expect("modes"))
+                    black_box(
+                        ModalAnalysis::compute_selected(&model, sel, s.term_selection.as_ref())
+                            .expect("modes"),
+                    )
                 })
             },
         );

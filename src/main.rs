@@ -279,9 +279,9 @@ fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
     // With an automatic term selection only the modes it aimed at are solved for (the higher
     // ones of such a model are not converged to anything).
     let selection = scenario.term_selection.as_ref();
-    let modes = ModalAnalysis::compute_lowest(&model, selection.map(|s| s.accuracy.modes))
-        .map_err(|e| numerical_failure(&scenario, &model, &e))?
-        .with_selection(selection);
+    let modes =
+        ModalAnalysis::compute_selected(&model, selection.map(|s| s.accuracy.modes), selection)
+            .map_err(|e| numerical_failure(&scenario, &model, &e))?;
     not_finite(path, flexcraft::finite::check_modes(&modes))?;
     let count = modes.elastic().count().clamp(1, 10);
     let states = match sweep {
@@ -325,9 +325,8 @@ fn run_export(c: &Common) -> Result<(), ExitCode> {
     let model = RitzModel::assemble(&scenario.structure);
     let wanted = scenario.export_modes();
     let selection = scenario.term_selection.as_ref();
-    let modes = ModalAnalysis::compute_lowest(&model, wanted)
-        .map_err(|e| numerical_failure(&scenario, &model, &e))?
-        .with_selection(selection);
+    let modes = ModalAnalysis::compute_selected(&model, wanted, selection)
+        .map_err(|e| numerical_failure(&scenario, &model, &e))?;
     not_finite(path, flexcraft::finite::check_modes(&modes))?;
     let available = modes.elastic().count();
     if let Some(w) = wanted.filter(|w| *w > available) {

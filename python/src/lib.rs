@@ -523,9 +523,8 @@ fn modes(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyRe
         let s = scenario.checked(max_memory)?;
         let model = RitzModel::assemble(&s.structure);
         let selection = s.term_selection.as_ref();
-        let modes = ModalAnalysis::compute_lowest(&model, selection.map(|s| s.accuracy.modes))
-            .map_err(|e| ritz_failure(&s, &model, &e))?
-            .with_selection(selection);
+        let modes = ModalAnalysis::compute_selected(&model, selection.map(|s| s.accuracy.modes), selection)
+            .map_err(|e| ritz_failure(&s, &model, &e))?;
         non_finite(&file, flexcraft::finite::check_modes(&modes))?;
         Ok(PyModes {
             src: ModesSource::Own(Box::new((model, modes))),
@@ -866,9 +865,8 @@ fn export(py: Python<'_>, scenario: &PyScenario, max_memory: Option<u64>) -> PyR
         let model = RitzModel::assemble(&s.structure);
         let wanted = s.export_modes();
         let selection = s.term_selection.as_ref();
-        let modes = ModalAnalysis::compute_lowest(&model, wanted)
-            .map_err(|e| ritz_failure(&s, &model, &e))?
-            .with_selection(selection);
+        let modes = ModalAnalysis::compute_selected(&model, wanted, selection)
+            .map_err(|e| ritz_failure(&s, &model, &e))?;
         non_finite(&file, flexcraft::finite::check_modes(&modes))?;
         let available = modes.elastic().count();
         let mut warnings = Vec::new();

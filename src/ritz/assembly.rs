@@ -357,8 +357,8 @@ impl RitzModel {
         let mut mass = Mat::<f64>::zeros(n, n);
         let mut stiffness = Mat::<f64>::zeros(n, n);
         let elements = assemble_into(structure, &mut mass, &mut stiffness);
-        symmetrize(&mut mass);
-        symmetrize(&mut stiffness);
+        // A pass over memory each (a large model's matrices pass the cache): side by side.
+        rayon::join(|| symmetrize(&mut mass), || symmetrize(&mut stiffness));
         Self {
             structure: structure.clone(),
             mass,

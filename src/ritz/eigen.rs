@@ -118,8 +118,11 @@ fn first_bad_pivot(m: &Mat<f64>) -> usize {
     n
 }
 
-/// Up to this many coordinates the dense solver of every mode is faster than the iteration
-/// (measured: 2 ms against 8 ms at 106 coordinates).
+/// Up to this many coordinates the dense solver of every mode is faster than an iteration
+/// from no start (measured: 2 ms against 8 ms at 106 coordinates). An iteration started from
+/// good vectors (a nested level's, [`Lowest::start`]) converges in two or three steps and is
+/// the faster one down to the block size (composite spacecraft, 109–146 coordinates:
+/// 0.6–1 ms against 1–1.5 ms).
 pub const DENSE_BELOW: usize = 160;
 
 /// Above this fraction of non-zero entries a dense factorisation is cheaper than a sparse one.
@@ -426,7 +429,7 @@ pub const LOWEST_MAX_ITERATIONS: usize = 400;
 /// Returns λ ascending and Φ (n × count) with ΦᵀMΦ = I.
 pub fn lowest(k: &Mat<f64>, m: &Mat<f64>, count: usize) -> Result<(Vec<f64>, Mat<f64>), RitzError> {
     let n = m.nrows();
-    if dense_route(n, 0, count) {
+    if dense_route(n, 0, count, false) {
         return dense_lowest(k, m, 0, count.min(n));
     }
     lowest_of(
@@ -450,11 +453,12 @@ pub struct Lowest<'a> {
     pub start: Option<&'a Mat<f64>>,
 }
 
-/// True when [`lowest_of`] solves densely.
-fn dense_route(n: usize, r: usize, count: usize) -> bool {
+/// True when [`lowest_of`] solves densely: the block would hold every mode, or the model is
+/// small and there is no start.
+fn dense_route(n: usize, r: usize, count: usize, started: bool) -> bool {
     let count = count.min(n - r);
     let p = (2 * count + 8).min(n - r);
-    p >= n - r || n <= DENSE_BELOW
+    p >= n - r || (n <= DENSE_BELOW && !started)
 }
 
 /// The dense route: every mode, then the `count` lowest.
@@ -495,7 +499,7 @@ pub fn lowest_of(
     if count == 0 {
         return Ok((Vec::new(), Mat::zeros(n, 0)));
     }
-    if dense_route(n, r, count) {
+    if dense_route(n, r, count, with.start.is_some()) {
         return dense_lowest(&ko.to_dense(), &mo.to_dense(), r, count);
     }
     let kdiag: Vec<f64> = (0..n).map(|i| ko.get(i, i)).collect();

@@ -129,6 +129,32 @@ impl ModalAnalysis {
     /// [`super::eigen::lowest_of`]: the fast route when a run needs ten modes of a model with a
     /// thousand coordinates. The hub-fixed list (effective masses) is cut to the same count.
     pub fn compute_lowest(model: &RitzModel, count: Option<usize>) -> Result<Self, RitzError> {
+        Self::compute_started(model, count, None)
+    }
+
+    /// [`Self::compute_lowest`] for a model built with an automatic term selection, the
+    /// selection attached ([`Self::with_selection`]): the selection has already solved this
+    /// model's pencil for the modes it aimed at, and its eigenvectors start the iteration
+    /// here (two steps instead of five).
+    pub fn compute_selected(
+        model: &RitzModel,
+        count: Option<usize>,
+        selection: Option<&super::refine::TermSelection>,
+    ) -> Result<Self, RitzError> {
+        let start = selection
+            .filter(|s| s.structure == model.structure)
+            .map(|s| &s.vectors);
+        Ok(Self::compute_started(model, count, start)?.with_selection(selection))
+    }
+
+    /// `start`: approximate eigenvectors of the pencil the modes come from (the free one for
+    /// a free hub, n rows; the hub-fixed one for a fixed hub, n − 6 rows); ignored when the
+    /// rows do not match.
+    fn compute_started(
+        model: &RitzModel,
+        count: Option<usize>,
+        start: Option<&Mat<f64>>,
+    ) -> Result<Self, RitzError> {
         let n = model.dof();
         let ne = n - HUB_DOF;
         let m = &model.mass;
@@ -138,14 +164,46 @@ impl ModalAnalysis {
         let wanted = count.map_or(ne, |c| c.min(ne));
         // The matrices as the eigen-solver holds them (sparse when they are), once; the
         // hub-fixed pencil (K_ee, M_ee) is their elastic sub-block.
-        let (ko, mo) = (Operator::from_dense(k), Operator::from_dense(m));
+        let (ko, mo) = rayon::join(|| Operator::from_dense(k), || Operator::from_dense(m));
         let elastic: Vec<usize> = (HUB_DOF..n).collect();
-        let (lam_f, phi_f) = lowest_of(
-            &ko.select(&elastic),
-            &mo.select(&elastic),
-            wanted,
-            &Lowest::default(),
-        )?;
+        let motion = model.structure.hub.motion;
+        // The start's elastic rows: the hub-fixed pencil's own vectors for a fixed hub, and a
+        // fair approximation of them (the free modes' elastic parts) for a free one.
+        let start_fixed = start.and_then(|v| match motion {
+            HubMotion::Fixed => (v.nrows() == ne).then(|| v.clone()),
+            HubMotion::Free => (v.nrows() == n).then(|| v.subrows(HUB_DOF, ne).to_owned()),
+        });
+        // The hub-fixed pencil and, for a free hub, the free one: independent solves, side
+        // by side (each sequential inside: the numbers do not depend on the cores).
+        let fixed_pencil = || {
+            lowest_of(
+                &ko.select(&elastic),
+                &mo.select(&elastic),
+                wanted,
+                &Lowest {
+                    null_space: 0,
+                    start: start_fixed.as_ref(),
+                },
+            )
+        };
+        // The eigenpairs of (K, M) M-orthogonal to the six rigid-body ones (K is zero on the
+        // hub's coordinates): their hub coordinates follow from the elastic ones by the hub's
+        // momentum equation, q_r = −M_rr⁻¹ M_re q_e.
+        let free_pencil = || match motion {
+            HubMotion::Fixed => Ok(None),
+            HubMotion::Free => lowest_of(
+                &ko,
+                &mo,
+                wanted,
+                &Lowest {
+                    null_space: HUB_DOF,
+                    start: start.filter(|v| v.nrows() == n),
+                },
+            )
+            .map(Some),
+        };
+        let (fixed, free) = rayon::join(fixed_pencil, free_pencil);
+        let ((lam_f, phi_f), free) = (fixed?, free?);
         let appendage_mass = appendage_mass(model, &mrr);
         let hub_fixed: Vec<HubFixedMode> = (0..wanted)
             .map(|j| {
@@ -177,7 +235,6 @@ impl ModalAnalysis {
             .collect();
 
         let mut modes = Vec::new();
-        let motion = model.structure.hub.motion;
         match motion {
             HubMotion::Fixed => {
                 for (j, h) in hub_fixed.iter().enumerate() {
@@ -190,14 +247,7 @@ impl ModalAnalysis {
             }
             HubMotion::Free => {
                 modes.extend(rigid_modes(model, &mrr));
-                // The eigenpairs of (K, M) M-orthogonal to the six rigid-body ones (K is
-                // zero on the hub's coordinates): their hub coordinates follow from the
-                // elastic ones by the hub's momentum equation, q_r = −M_rr⁻¹ M_re q_e.
-                let with = Lowest {
-                    null_space: HUB_DOF,
-                    start: None,
-                };
-                let (lam, phi) = lowest_of(&ko, &mo, wanted, &with)?;
+                let (lam, phi) = free.expect("solved for a free hub");
                 for (j, &lambda) in lam.iter().enumerate() {
                     let shape = (0..n).map(|i| phi[(i, j)]).collect();
                     modes.push(elastic_mode(lambda, shape, None));

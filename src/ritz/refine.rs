@@ -219,6 +219,10 @@ pub struct TermSelection {
     pub solves: usize,
     /// Model assemblies made.
     pub assemblies: usize,
+    /// The wanted modes' eigenvectors in the chosen model (columns, M-orthonormal), rows in
+    /// the model's coordinate order: all of them for a free hub, the elastic ones for a fixed
+    /// hub. They start the final solve ([`super::ModalAnalysis::compute_selected`]).
+    pub vectors: Mat<f64>,
 }
 
 /// A model assembled at counts at least those of every level it serves: each level's
@@ -491,6 +495,10 @@ struct Selector<'a> {
     ahead: Vec<Option<Ahead>>,
     /// Per plate family pair, at the length family's index: the last joint step.
     joint: Vec<Option<Joint>>,
+    /// Every level solved so far, by every family's counts: the selection comes back to a
+    /// level it has solved (a forward step's level measured again after its component's other
+    /// direction moved), and a solve is most of its cost.
+    solved: std::collections::HashMap<Vec<usize>, (Vec<f64>, Vectors)>,
     solves: usize,
     assemblies: usize,
 }
@@ -581,19 +589,11 @@ impl Selector<'_> {
         if self.joint[l].as_ref().is_some_and(|j| j.at == counts) {
             return Ok(());
         }
-        let (fl, fw) = (self.families[l].0, self.families[w].0);
         let plate = self.plate_counts(l, w);
-        let (nl, nw) = (finer(plate.0), finer(plate.1));
-        let (Some(nl), Some(nw)) = (nl, nw) else {
+        let Some(level) = self.joint_level(l, w) else {
             return Ok(());
         };
-        let mut st = self.structure.clone();
-        fl.set(&mut st, nl);
-        fw.set(&mut st, nw);
-        if dof(&st) > self.accuracy.max_dof {
-            return Ok(());
-        }
-        let (omega, vectors) = self.solve_at(&[(fl, nl), (fw, nw)])?;
+        let (omega, vectors) = self.solve_at(&level)?;
         let len = self.omega.len().min(omega.len());
         let change = (0..len).map(|k| self.omega[k] - omega[k]).collect();
         self.joint[l] = Some(Joint {
@@ -604,6 +604,18 @@ impl Selector<'_> {
             change,
         });
         Ok(())
+    }
+
+    /// The plate's joint step from the current counts: both directions one refinement up
+    /// (None past [`MAX_TERMS`] or `max_dof`).
+    fn joint_level(&self, l: usize, w: usize) -> Option<Vec<(Family, usize)>> {
+        let (fl, fw) = (self.families[l].0, self.families[w].0);
+        let (pl, pw) = self.plate_counts(l, w);
+        let (nl, nw) = (finer(pl)?, finer(pw)?);
+        let mut st = self.structure.clone();
+        fl.set(&mut st, nl);
+        fw.set(&mut st, nw);
+        (dof(&st) <= self.accuracy.max_dof).then(|| vec![(fl, nl), (fw, nw)])
     }
 
     fn automatic(&self) -> Vec<Family> {
@@ -621,17 +633,48 @@ impl Selector<'_> {
 
     /// ω of the structure with some families' counts changed (the ceiling grown if needed).
     fn solve_at(&mut self, changes: &[(Family, usize)]) -> Result<(Vec<f64>, Vectors), RitzError> {
+        self.prefetch(&[changes.to_vec()])?;
+        let counts = self.counts_with(changes);
+        Ok(self.solved[&counts].clone())
+    }
+
+    /// Every family's counts with some changed.
+    fn counts_with(&self, changes: &[(Family, usize)]) -> Vec<usize> {
         let mut st = self.structure.clone();
         for &(family, n) in changes {
             family.set(&mut st, n);
         }
+        self.families.iter().map(|(f, _)| f.count(&st)).collect()
+    }
+
+    /// Solves every level of `levels` (each: some families' counts changed from the current
+    /// ones) not solved yet, side by side on the machine's cores: they are independent (each
+    /// starts from the current level's vectors and runs sequentially, so the numbers do not
+    /// depend on the number of cores), and a level's measurement needs two or three of them.
+    /// The ceiling is grown once to cover them all.
+    fn prefetch(&mut self, levels: &[Vec<(Family, usize)>]) -> Result<(), RitzError> {
+        let mut todo: Vec<(Vec<usize>, Structure)> = Vec::new();
+        for changes in levels {
+            let counts = self.counts_with(changes);
+            if self.solved.contains_key(&counts) || todo.iter().any(|(c, _)| *c == counts) {
+                continue;
+            }
+            let mut st = self.structure.clone();
+            for &(family, n) in changes {
+                family.set(&mut st, n);
+            }
+            todo.push((counts, st));
+        }
+        if todo.is_empty() {
+            return Ok(());
+        }
         let auto = self.automatic();
-        if !self.ceiling.covers(&st, &auto) {
+        if !todo.iter().all(|(_, st)| self.ceiling.covers(st, &auto)) {
             // Grow the outgrown families one refinement beyond the need (none where that
             // would pass max_dof), keep the rest: the next level's forward steps fit.
             let mut top = self.ceiling.structure.clone();
             for f in &auto {
-                let need = f.count(&st);
+                let need = todo.iter().map(|(_, st)| f.count(st)).max().unwrap_or(0);
                 if need > f.count(&top) {
                     let room = [finer(need)].into_iter().flatten().find(|&g| {
                         let mut t = top.clone();
@@ -644,9 +687,53 @@ impl Selector<'_> {
             self.ceiling = Ceiling::new(&top);
             self.assemblies += 1;
         }
-        self.solves += 1;
-        self.ceiling
-            .frequencies(&st, self.accuracy.modes, Some(&self.vectors))
+        self.solves += todo.len();
+        let (ceiling, modes, start) = (&self.ceiling, self.accuracy.modes, &self.vectors);
+        let solved: Vec<_> = {
+            use rayon::prelude::*;
+            todo.par_iter()
+                .map(|(_, st)| ceiling.frequencies(st, modes, Some(start)))
+                .collect()
+        };
+        for ((counts, _), r) in todo.into_iter().zip(solved) {
+            self.solved.insert(counts, r?);
+        }
+        Ok(())
+    }
+
+    /// The levels [`Self::measure`] will solve for families `which` at the current counts:
+    /// one refinement up for a forward measurement, and a plate's joint step; two coarser
+    /// levels for a backward one.
+    fn measurement_levels(&self, which: &[usize]) -> Vec<Vec<(Family, usize)>> {
+        let mut levels = Vec::new();
+        for &i in which {
+            let f = self.families[i].0;
+            let n = f.count(&self.structure);
+            if self.forward_possible(i) {
+                levels.push(vec![(f, finer(n).expect("forward_possible"))]);
+                if let Some((l, w)) = self.plate_pair(i) {
+                    if self.forward_possible(l) && self.forward_possible(w) {
+                        levels.extend(self.joint_level(l, w));
+                    }
+                }
+            } else if let Some(n1) = coarser(n) {
+                levels.push(vec![(f, n1)]);
+                if let Some(n0) = coarser(n1) {
+                    levels.push(vec![(f, n0)]);
+                }
+            }
+        }
+        levels
+    }
+
+    /// [`Self::measure`] for several families, their solves made side by side first.
+    fn measure_all(&mut self, which: &[usize]) -> Result<(), RitzError> {
+        let levels = self.measurement_levels(which);
+        self.prefetch(&levels)?;
+        for &i in which {
+            self.measure(i)?;
+        }
+        Ok(())
     }
 
     /// Estimated error of every wanted mode, per family (absolute, rad/s).
@@ -776,8 +863,7 @@ impl Selector<'_> {
                         self.round += 1;
                         self.refined_at[i] = self.round;
                         self.refined_at[other] = self.round;
-                        self.measure(i)?;
-                        self.measure(other)?;
+                        self.measure_all(&[i, other])?;
                         return Ok(true);
                     }
                 }
@@ -791,7 +877,7 @@ impl Selector<'_> {
             self.vectors = vectors;
             self.round += 1;
             self.refined_at[i] = self.round;
-            self.measure(i)?;
+            self.measure_all(&[i])?;
             return Ok(true);
         }
         Ok(false)
@@ -834,9 +920,7 @@ impl Selector<'_> {
         let stale: Vec<usize> = (0..self.families.len())
             .filter(|&i| self.stale(i))
             .collect();
-        for &i in &stale {
-            self.measure(i)?;
-        }
+        self.measure_all(&stale)?;
         Ok(!stale.is_empty())
     }
 
@@ -922,14 +1006,13 @@ pub fn select_terms(
         vectors,
         ahead: vec![None; n],
         joint: vec![None; n],
+        solved: std::collections::HashMap::new(),
         solves: 1,
         assemblies: 1,
     };
     // Automatic families forward; given ones from two coarser levels of the same model
     // (sub-blocks, no re-assembly).
-    for i in 0..n {
-        sel.measure(i)?;
-    }
+    sel.measure_all(&(0..n).collect::<Vec<_>>())?;
     // Refine until the estimate is below the tolerance with every family measured at the
     // final counts of its component.
     const MAX_ROUNDS: usize = 500;
@@ -966,6 +1049,7 @@ pub fn select_terms(
         reached,
         solves: sel.solves,
         assemblies: sel.assemblies,
+        vectors: sel.vectors.values,
     })
 }
 

@@ -296,3 +296,50 @@ fn cfff_plate_reaches_every_tolerance_with_an_honest_estimate() {
     // 1e-6).
     check_selection("CFFF plate", &[1e-3, 1e-4, 1e-5], auto, &reference, 10);
 }
+
+/// The final solve started from the selection's own eigenvectors
+/// (`ModalAnalysis::compute_selected`) gives the modes of the cold solve
+/// (`compute_lowest`): frequencies to 1e-10 relative, M-orthonormal shapes to 1e-10, and
+/// the hub-fixed frequencies (whose pencil the selection never solved for a free hub) too.
+#[test]
+fn the_warm_started_final_solve_equals_the_cold_one() {
+    for motion in ["fixed", "free"] {
+        let s = scenario(&composite(
+            motion,
+            "",
+            "",
+            "tolerance = 1e-5\nmodes = 10\nmax_dof = 3000",
+        ));
+        let sel = s.term_selection.as_ref().expect("a selection");
+        let model = RitzModel::assemble(&s.structure);
+        let cold = ModalAnalysis::compute_lowest(&model, Some(10)).expect("cold");
+        let warm = ModalAnalysis::compute_selected(&model, Some(10), Some(sel)).expect("warm");
+        assert!(warm.selection.is_some());
+        let (wc, ww) = (elastic_omegas(&cold), elastic_omegas(&warm));
+        assert_eq!(wc.len(), ww.len());
+        for (a, b) in wc.iter().zip(&ww) {
+            assert!((a / b - 1.0).abs() < 1e-10, "{motion}: {a} vs {b}");
+        }
+        for (a, b) in cold.hub_fixed.iter().zip(&warm.hub_fixed) {
+            let (a, b) = (a.omega_rad_s, b.omega_rad_s);
+            assert!(
+                (a / b - 1.0).abs() < 1e-10,
+                "{motion}, hub fixed: {a} vs {b}"
+            );
+        }
+        let m = &model.mass;
+        let shapes: Vec<&Vec<f64>> = warm.elastic().map(|md| &md.shape).collect();
+        for (i, x) in shapes.iter().enumerate() {
+            for (j, y) in shapes.iter().enumerate() {
+                let mut xy = 0.0;
+                for r in 0..m.nrows() {
+                    for c in 0..m.ncols() {
+                        xy += x[r] * m[(r, c)] * y[c];
+                    }
+                }
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((xy - want).abs() < 1e-10, "{motion}: φ{i}ᵀMφ{j} = {xy}");
+            }
+        }
+    }
+}
