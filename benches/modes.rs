@@ -9,6 +9,11 @@ use std::hint::black_box;
 
 const SEED: &str = include_str!("../examples/seed.toml");
 
+/// The command line's allocator (src/main.rs), so that the figures are the tool's: the
+/// system allocator maps and faults a large model's matrices afresh on every iteration.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// The seed scenario with other term counts: beam (bending, torsion, axial), plate (length, width).
 fn seed_with(beam: (usize, usize, usize), plate: (usize, usize)) -> Scenario {
     let src = SEED

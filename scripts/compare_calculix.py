@@ -13,8 +13,10 @@ time ratios hold on another machine; the absolute times do not (nor on a loaded 
 What is compared: the first 10 elastic frequencies of the free spacecraft of
 examples/composite.toml (the six rigid-body modes come first in both tools and are skipped).
 Both tools run as whole processes (start, read, assemble, solve, print), best of 3, on one
-thread: flexcraft is sequential (faer without its "rayon" feature), and ccx gets
-OMP_NUM_THREADS=1 (its default; with 2 threads on a busy 2-core machine it spun 20× slower).
+thread: flexcraft gets RAYON_NUM_THREADS=1 (its automatic term selection otherwise runs a
+level's independent solves side by side; every factorisation is sequential anyway, faer
+without its "rayon" feature), and ccx gets OMP_NUM_THREADS=1 (its default; with 2 threads on
+a busy 2-core machine it spun 20× slower).
 
 flexcraft: `flexcraft modes --json` on copies of the example with `[ritz] tolerance` 1e-2 …
 1e-6 (automatic terms) and with explicit `terms` sequences (no `[ritz]` table).
@@ -299,7 +301,8 @@ def scenario_variant(text, terms=None, tolerance=None, max_dof=None):
 def run_flexcraft(workdir, label, text, repeats):
     path = workdir / f"fc_{re.sub(r'[^A-Za-z0-9]+', '_', label)}.toml"
     path.write_text(text)
-    t, out = best_time([str(FLEXCRAFT), "modes", str(path), "--json"], repeats)
+    env = dict(os.environ, RAYON_NUM_THREADS="1")
+    t, out = best_time([str(FLEXCRAFT), "modes", str(path), "--json"], repeats, env=env)
     d = json.loads(out)
     modes = d["modes"]
     assert all(m["rigid"] for m in modes[:N_RIGID]) and not modes[N_RIGID]["rigid"]
