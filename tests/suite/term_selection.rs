@@ -343,3 +343,25 @@ fn the_warm_started_final_solve_equals_the_cold_one() {
         }
     }
 }
+
+/// A level's independent solves run side by side, each sequential inside: the selection's
+/// counts, frequencies and estimates are bit-for-bit the same on one thread and on four.
+#[test]
+fn the_selection_does_not_depend_on_the_number_of_threads() {
+    let toml = composite("free", "", "", "tolerance = 1e-5\nmodes = 10");
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| scenario(&toml))
+            .term_selection
+            .expect("a selection")
+    };
+    let (a, b) = (on(1), on(4));
+    assert_eq!(a.dof, b.dof);
+    assert_eq!(a.solves, b.solves);
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a.omega), bits(&b.omega));
+    assert_eq!(bits(&a.frequency_error), bits(&b.frequency_error));
+}
