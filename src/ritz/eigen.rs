@@ -561,16 +561,11 @@ pub fn lowest_of(
     // spread over all coordinates so that no wanted mode is orthogonal to the start.
     let mut order: Vec<usize> = (r..n).collect();
     order.sort_by(|&i, &j| (kdiag[i] / mdiag[i]).total_cmp(&(kdiag[j] / mdiag[j])));
-    let mut x = Mat::from_fn(n, p, |i, j| {
-        1e-3 * ((i + 1) as f64 * (j + 1) as f64 * 0.618).sin()
-    });
     let given = with.start.map_or(0, |v| v.ncols().min(p));
-    for j in 0..given {
-        let v = with.start.expect("given");
-        for i in 0..n {
-            x[(i, j)] = v[(i, j)];
-        }
-    }
+    let mut x = Mat::from_fn(n, p, |i, j| match with.start {
+        Some(v) if j < given => v[(i, j)],
+        _ => 1e-3 * ((i + 1) as f64 * (j + 1) as f64 * 0.618).sin(),
+    });
     for (j, &i) in order.iter().take(p - given).enumerate() {
         x[(i, given + j)] += 1.0;
     }
