@@ -59,6 +59,11 @@ pub const SAFETY: f64 = 1.25;
 pub const FORWARD_SAFETY: f64 = 1.0;
 /// Factor on a plate's single-direction estimates when its joint step cannot be measured.
 pub const CORNER: f64 = 2.0;
+/// A family whose estimated relative error is below this fraction of the tolerance is not
+/// refined.
+pub const NEGLIGIBLE: f64 = 1e-3;
+/// Least growth of a last step shortened to fit `max_dof`.
+pub const FIT_GROWTH: f64 = 1.1;
 /// Growth factor of a refinement.
 pub const GROWTH: f64 = 1.5;
 
@@ -821,7 +826,11 @@ impl Selector<'_> {
                 (worst, i)
             })
             .collect();
-        // Largest error first; ties in family order (deterministic).
+        // Largest error first; ties in family order (deterministic). A family whose error is
+        // negligible against the tolerance is not refined: when only such families can still
+        // grow, the rest of the error sits in families that cannot, and growing these would
+        // spend the size limit for nothing.
+        order.retain(|&(e, _)| e >= NEGLIGIBLE * self.accuracy.tolerance);
         order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         for (_, i) in order {
             let f = self.families[i].0;
@@ -833,8 +842,31 @@ impl Selector<'_> {
             let mut st = self.structure.clone();
             f.set(&mut st, m);
             if dof(&st) > self.accuracy.max_dof {
-                self.exhausted[i] = true;
-                continue;
+                // A last, shorter step to the most the size limit allows (at least
+                // [`FIT_GROWTH`]); the family is measured backward there.
+                let fits = |c: usize| {
+                    let mut t = self.structure.clone();
+                    f.set(&mut t, c);
+                    dof(&t) <= self.accuracy.max_dof
+                };
+                let least = ((n as f64 * FIT_GROWTH).ceil() as usize).max(n + 1);
+                match (least..m).rev().find(|&c| fits(c)) {
+                    Some(c) => {
+                        f.set(&mut st, c);
+                        let (omega, vectors) = self.solve_with(f, c)?;
+                        self.structure = st;
+                        self.omega = omega;
+                        self.vectors = vectors;
+                        self.round += 1;
+                        self.refined_at[i] = self.round;
+                        self.measure_all(&[i])?;
+                        return Ok(true);
+                    }
+                    None => {
+                        self.exhausted[i] = true;
+                        continue;
+                    }
+                }
             }
             let counts = self.counts();
             // A plate whose other direction leaves at least half this one's error: both
