@@ -358,7 +358,11 @@ impl RitzModel {
         let mut stiffness = Mat::<f64>::zeros(n, n);
         let elements = assemble_into(structure, &mut mass, &mut stiffness);
         // A pass over memory each (a large model's matrices pass the cache): side by side.
-        rayon::join(|| symmetrize(&mut mass), || symmetrize(&mut stiffness));
+        super::parallel::join(
+            n >= PARALLEL_FROM,
+            || symmetrize(&mut mass),
+            || symmetrize(&mut stiffness),
+        );
         Self {
             structure: structure.clone(),
             mass,
@@ -456,6 +460,10 @@ impl RitzModel {
         }
     }
 }
+
+/// From this many coordinates up, the two matrices' passes run side by side (a thread's
+/// start, some 50 µs, is then small against them).
+pub const PARALLEL_FROM: usize = 400;
 
 fn symmetrize(m: &mut Mat<f64>) {
     let n = m.nrows();

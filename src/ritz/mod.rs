@@ -10,6 +10,7 @@
 pub mod assembly;
 pub mod eigen;
 pub mod modes;
+pub mod parallel;
 pub mod refine;
 pub mod shapes;
 

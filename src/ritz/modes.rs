@@ -15,6 +15,7 @@
 
 use super::assembly::{ElementKind, RitzModel, HUB_DOF};
 use super::eigen::{lowest_of, Lowest, Operator};
+use super::parallel;
 use super::RitzError;
 use crate::math::Vec3;
 use crate::structure::{Attachment, ComponentId, HubMotion, RigidBody};
@@ -164,7 +165,12 @@ impl ModalAnalysis {
         let wanted = count.map_or(ne, |c| c.min(ne));
         // The matrices as the eigen-solver holds them (sparse when they are), once; the
         // hub-fixed pencil (K_ee, M_ee) is their elastic sub-block.
-        let (ko, mo) = rayon::join(|| Operator::from_dense(k), || Operator::from_dense(m));
+        let large = n >= super::assembly::PARALLEL_FROM;
+        let (ko, mo) = parallel::join(
+            large,
+            || Operator::from_dense(k),
+            || Operator::from_dense(m),
+        );
         let elastic: Vec<usize> = (HUB_DOF..n).collect();
         let motion = model.structure.hub.motion;
         // The start's elastic rows: the hub-fixed pencil's own vectors for a fixed hub, and a
@@ -202,7 +208,7 @@ impl ModalAnalysis {
             )
             .map(Some),
         };
-        let (fixed, free) = rayon::join(fixed_pencil, free_pencil);
+        let (fixed, free) = parallel::join(large, fixed_pencil, free_pencil);
         let ((lam_f, phi_f), free) = (fixed?, free?);
         let appendage_mass = appendage_mass(model, &mrr);
         let hub_fixed: Vec<HubFixedMode> = (0..wanted)

@@ -694,12 +694,8 @@ impl Selector<'_> {
         }
         self.solves += todo.len();
         let (ceiling, modes, start) = (&self.ceiling, self.accuracy.modes, &self.vectors);
-        let solved: Vec<_> = {
-            use rayon::prelude::*;
-            todo.par_iter()
-                .map(|(_, st)| ceiling.frequencies(st, modes, Some(start)))
-                .collect()
-        };
+        let solved =
+            super::parallel::map(&todo, |(_, st)| ceiling.frequencies(st, modes, Some(start)));
         for ((counts, _), r) in todo.into_iter().zip(solved) {
             self.solved.insert(counts, r?);
         }
