@@ -467,15 +467,9 @@ struct Joint {
     at: Vec<usize>,
     /// The plate's (length, width) counts when it was measured.
     plate: (usize, usize),
-    /// ω with both directions one refinement up, and the eigenvectors.
-    omega: Vec<f64>,
-    vectors: Vectors,
     /// The change of every wanted ω (rad/s).
     change: Vec<f64>,
 }
-
-/// A forward solve: every family's count it was made at, ω and the eigenvectors.
-type Ahead = (Vec<usize>, Vec<f64>, Vectors);
 
 /// The selection's state: counts, ceiling, steps per family.
 struct Selector<'a> {
@@ -495,9 +489,6 @@ struct Selector<'a> {
     omega: Vec<f64>,
     /// The current level's eigenvectors (each solve starts from them).
     vectors: Vectors,
-    /// Per family: its last forward solve, ω with that family one refinement up from the
-    /// counts (of every family) it was made at — the next level if that family is refined.
-    ahead: Vec<Option<Ahead>>,
     /// Per plate family pair, at the length family's index: the last joint step.
     joint: Vec<Option<Joint>>,
     /// Every level solved so far, by every family's counts: the selection comes back to a
@@ -535,7 +526,7 @@ impl Selector<'_> {
         let f = self.families[i].0;
         let n = f.count(&self.structure);
         let m = finer(n).expect("forward_possible");
-        let (fine, vectors) = self.solve_with(f, m)?;
+        let (fine, _) = self.solve_with(f, m)?;
         let s = step(n, m, &self.omega, &fine);
         if self.forward[i] {
             self.steps[i].push(s);
@@ -543,7 +534,6 @@ impl Selector<'_> {
             self.steps[i] = vec![s];
             self.forward[i] = true;
         }
-        self.ahead[i] = Some((self.counts(), fine, vectors));
         self.measured_at[i] = self.round;
         Ok(())
     }
@@ -598,14 +588,12 @@ impl Selector<'_> {
         let Some(level) = self.joint_level(l, w) else {
             return Ok(());
         };
-        let (omega, vectors) = self.solve_at(&level)?;
+        let (omega, _) = self.solve_at(&level)?;
         let len = self.omega.len().min(omega.len());
         let change = (0..len).map(|k| self.omega[k] - omega[k]).collect();
         self.joint[l] = Some(Joint {
             at: counts,
             plate,
-            omega,
-            vectors,
             change,
         });
         Ok(())
@@ -847,24 +835,13 @@ impl Selector<'_> {
                 };
                 let least = ((n as f64 * FIT_GROWTH).ceil() as usize).max(n + 1);
                 match (least..m).rev().find(|&c| fits(c)) {
-                    Some(c) => {
-                        f.set(&mut st, c);
-                        let (omega, vectors) = self.solve_with(f, c)?;
-                        self.structure = st;
-                        self.omega = omega;
-                        self.vectors = vectors;
-                        self.round += 1;
-                        self.refined_at[i] = self.round;
-                        self.measure_all(&[i])?;
-                        return Ok(true);
-                    }
+                    Some(c) => return self.adopt(&[(f, c)], &[i]),
                     None => {
                         self.exhausted[i] = true;
                         continue;
                     }
                 }
             }
-            let counts = self.counts();
             // A plate whose other direction leaves at least half this one's error: both
             // directions at once (the joint step's solve is that level).
             if let Some((l, w)) = self.plate_pair(i) {
@@ -881,34 +858,31 @@ impl Selector<'_> {
                     let mut st2 = st.clone();
                     g.set(&mut st2, mg);
                     if dof(&st2) <= self.accuracy.max_dof {
-                        let (omega, vectors) = match self.joint[l].take() {
-                            Some(j) if j.at == counts => (j.omega, j.vectors),
-                            _ => self.solve_at(&[(f, m), (g, mg)])?,
-                        };
-                        self.structure = st2;
-                        self.omega = omega;
-                        self.vectors = vectors;
-                        self.round += 1;
-                        self.refined_at[i] = self.round;
-                        self.refined_at[other] = self.round;
-                        self.measure_all(&[i, other])?;
-                        return Ok(true);
+                        return self.adopt(&[(f, m), (g, mg)], &[i, other]);
                     }
                 }
             }
-            let (omega, vectors) = match self.ahead[i].take() {
-                Some((at, w, v)) if at == counts => (w, v),
-                _ => self.solve_with(f, m)?,
-            };
-            self.structure = st;
-            self.omega = omega;
-            self.vectors = vectors;
-            self.round += 1;
-            self.refined_at[i] = self.round;
-            self.measure_all(&[i])?;
-            return Ok(true);
+            return self.adopt(&[(f, m)], &[i]);
         }
         Ok(false)
+    }
+
+    /// Moves to the level with some families' counts changed (its solve is usually known
+    /// already: the forward or joint step that measured it) and measures those families
+    /// there.
+    fn adopt(&mut self, changes: &[(Family, usize)], refined: &[usize]) -> Result<bool, RitzError> {
+        let (omega, vectors) = self.solve_at(changes)?;
+        for &(family, n) in changes {
+            family.set(&mut self.structure, n);
+        }
+        self.omega = omega;
+        self.vectors = vectors;
+        self.round += 1;
+        for &i in refined {
+            self.refined_at[i] = self.round;
+        }
+        self.measure_all(refined)?;
+        Ok(true)
     }
 
     /// A family's steps were measured before another family of its component changed
@@ -1032,7 +1006,6 @@ pub fn select_terms(
         ceiling,
         omega,
         vectors,
-        ahead: vec![None; n],
         joint: vec![None; n],
         solved: std::collections::HashMap::new(),
         solves: 1,
