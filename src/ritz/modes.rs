@@ -241,8 +241,9 @@ impl ModalAnalysis {
             .collect();
 
         let mut modes = Vec::new();
-        match motion {
-            HubMotion::Fixed => {
+        // The free pencil was solved exactly when the hub is free.
+        match free {
+            None => {
                 for (j, h) in hub_fixed.iter().enumerate() {
                     modes.push(elastic_mode(
                         lam_f[j],
@@ -251,9 +252,8 @@ impl ModalAnalysis {
                     ));
                 }
             }
-            HubMotion::Free => {
+            Some((lam, phi)) => {
                 modes.extend(rigid_modes(model, &mrr));
-                let (lam, phi) = free.expect("solved for a free hub");
                 for (j, &lambda) in lam.iter().enumerate() {
                     let shape = (0..n).map(|i| phi[(i, j)]).collect();
                     modes.push(elastic_mode(lambda, shape, None));
