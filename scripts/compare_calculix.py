@@ -13,9 +13,10 @@ time ratios hold on another machine; the absolute times do not (nor on a loaded 
 What is compared: the first 10 elastic frequencies of the free spacecraft of
 examples/composite.toml (the six rigid-body modes come first in both tools and are skipped).
 Both tools run as whole processes (start, read, assemble, solve, print), best of 3, on one
-thread: flexcraft gets RAYON_NUM_THREADS=1 (its automatic term selection otherwise runs a
-level's independent solves side by side; every factorisation is sequential anyway, faer
-without its "rayon" feature), and ccx gets OMP_NUM_THREADS=1 (its default; with 2 threads on
+thread: flexcraft gets RAYON_NUM_THREADS=1 (it otherwise runs independent work side by
+side: a term selection level's solves, the final hub-fixed and free pencils, a large
+model's two symmetrisations; every factorisation is sequential anyway, faer without its
+"rayon" feature), and ccx gets OMP_NUM_THREADS=1 (its default; with 2 threads on
 a busy 2-core machine it spun 20× slower).
 
 flexcraft: `flexcraft modes --json` on copies of the example with `[ritz] tolerance` 1e-2 …

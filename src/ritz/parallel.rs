@@ -20,25 +20,37 @@ use rayon::prelude::*;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 use std::sync::{Arc, Mutex};
 
-/// This process's pool (None when no thread could be started: then everything runs on the
-/// calling thread).
+/// This process's pool (None when no thread could be started, or when the caller already
+/// runs on a rayon worker — a Monte Carlo run on its `--jobs` pool: waiting there for
+/// another pool would let the worker steal further runs onto the same stack, nesting without
+/// bound, and would add threads beyond `--jobs`; such a caller computes on its own thread).
 fn pool() -> Option<Arc<ThreadPool>> {
     static POOL: Mutex<Option<(u32, Arc<ThreadPool>)>> = Mutex::new(None);
+    if rayon::current_thread_index().is_some() {
+        return None;
+    }
     let pid = std::process::id();
-    let mut slot = POOL.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((owner, pool)) = slot.as_ref() {
+    let lock = || POOL.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((owner, pool)) = lock().as_ref() {
         if *owner == pid {
             return Some(pool.clone());
         }
     }
-    // Made before a fork: its workers live in the parent only. Dropping it would signal
-    // them; forgetting it leaves the child's memory as the fork gave it.
-    if let Some(stale) = slot.take() {
-        std::mem::forget(stale);
+    // Built with the lock released: a fork while the threads start (another thread of a
+    // Python program) must not leave the child a locked mutex.
+    let fresh = Arc::new(ThreadPoolBuilder::new().build().ok()?);
+    let mut slot = lock();
+    match slot.as_ref() {
+        Some((owner, pool)) if *owner == pid => Some(pool.clone()),
+        _ => {
+            // Made before a fork: its workers live in the parent only. Dropping it would
+            // signal them; forgetting it leaves the child's memory as the fork gave it.
+            if let Some(stale) = slot.replace((pid, fresh.clone())) {
+                std::mem::forget(stale);
+            }
+            Some(fresh)
+        }
     }
-    let pool = Arc::new(ThreadPoolBuilder::new().build().ok()?);
-    *slot = Some((pid, pool.clone()));
-    Some(pool)
 }
 
 /// `f` of every item, in the items' order, side by side.
@@ -75,5 +87,19 @@ mod tests {
         assert_eq!(map(&[] as &[usize], |i| *i), Vec::<usize>::new());
         assert_eq!(join(true, || 1, || "b"), (1, "b"));
         assert_eq!(join(false, || 2, || 3), (2, 3));
+    }
+
+    /// On a worker of another pool (a Monte Carlo run) nothing is handed to this module's
+    /// pool: the work stays on the caller's thread, and the results are the same.
+    #[test]
+    fn a_rayon_worker_computes_on_its_own_thread() {
+        let outer = ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("pool");
+        let items: Vec<usize> = (0..9).collect();
+        let (no_pool, squares) = outer.install(|| (pool().is_none(), map(&items, |i| i * i)));
+        assert!(no_pool);
+        assert_eq!(squares, items.iter().map(|i| i * i).collect::<Vec<_>>());
     }
 }

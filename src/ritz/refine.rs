@@ -1025,7 +1025,11 @@ pub fn select_terms(
             break;
         }
         if !sel.refine_worst()? {
-            sel.refresh()?;
+            // Nothing left to refine by the current estimates; if some were stale, their
+            // fresh values may make a family worth refining again.
+            if sel.refresh()? {
+                continue;
+            }
             break;
         }
     }
