@@ -627,17 +627,19 @@ impl Selector<'_> {
     /// ω of the structure with some families' counts changed (the ceiling grown if needed).
     fn solve_at(&mut self, changes: &[(Family, usize)]) -> Result<(Vec<f64>, Vectors), RitzError> {
         self.prefetch(&[changes.to_vec()])?;
-        let counts = self.counts_with(changes);
+        let (counts, _) = self.level(changes);
         Ok(self.solved[&counts].clone())
     }
 
-    /// Every family's counts with some changed.
-    fn counts_with(&self, changes: &[(Family, usize)]) -> Vec<usize> {
+    /// The structure with some families' counts changed, and every family's count in it
+    /// (the level's key).
+    fn level(&self, changes: &[(Family, usize)]) -> (Vec<usize>, Structure) {
         let mut st = self.structure.clone();
         for &(family, n) in changes {
             family.set(&mut st, n);
         }
-        self.families.iter().map(|(f, _)| f.count(&st)).collect()
+        let counts = self.families.iter().map(|(f, _)| f.count(&st)).collect();
+        (counts, st)
     }
 
     /// Solves every level of `levels` (each: some families' counts changed from the current
@@ -648,15 +650,10 @@ impl Selector<'_> {
     fn prefetch(&mut self, levels: &[Vec<(Family, usize)>]) -> Result<(), RitzError> {
         let mut todo: Vec<(Vec<usize>, Structure)> = Vec::new();
         for changes in levels {
-            let counts = self.counts_with(changes);
-            if self.solved.contains_key(&counts) || todo.iter().any(|(c, _)| *c == counts) {
-                continue;
+            let (counts, st) = self.level(changes);
+            if !self.solved.contains_key(&counts) && !todo.iter().any(|(c, _)| *c == counts) {
+                todo.push((counts, st));
             }
-            let mut st = self.structure.clone();
-            for &(family, n) in changes {
-                family.set(&mut st, n);
-            }
-            todo.push((counts, st));
         }
         if todo.is_empty() {
             return Ok(());
