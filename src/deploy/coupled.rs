@@ -33,6 +33,7 @@
 //! the multipliers λ = (CCᵀ)⁻¹ C (M u̇ + c − Q)) or a torsional spring k_c per loop
 //! (V = ½ k_c |C (α − α(0))|²).
 
+use super::articulated;
 use super::attitude::{self, Quaternion};
 use super::base::BaseModel;
 use super::chain::{Chain, P2};
@@ -305,6 +306,13 @@ impl Coupled {
 
     /// [`Coupled::evaluate`] into the buffers of `ws` (no allocation once they are sized).
     fn assemble(&self, y: &[f64], ws: &mut Workspace) {
+        self.assemble_parts(y, ws, true);
+    }
+
+    /// The evaluation's parts into `ws`: the base block M_bb = M_base + Bᵀ M₁₁ B of the mass
+    /// matrix, c and Q always; the whole mass matrix (with the chain's Bᵀ M₁₂ and M₂₂, O(N²))
+    /// when `dense`.
+    fn assemble_parts(&self, y: &[f64], ws: &mut Workspace, dense: bool) {
         let s = self.view(y);
         let base = &self.base;
         let inv = &base.invariants;
@@ -362,51 +370,48 @@ impl Coupled {
         ws.frame = frame;
         ws.hinge = hinge;
         ws.a_bias = a_bias;
-        self.chain_blocks(s.alpha, s.alpha_dot, omega_h, &mut ws.chain);
+        self.chain_blocks(s.alpha, s.alpha_dot, omega_h, &mut ws.chain, dense);
         // Assemble.
         let ns = nb + n;
-        refill(&mut ws.mass, ns * ns, 0.0);
+        refill(&mut ws.mbb, nb * nb, 0.0);
         refill(&mut ws.bias, ns, 0.0);
         self.base_terms(&s, ws);
-        let (b, mass, bias) = (&ws.b, &mut ws.mass, &mut ws.bias);
-        let (mc, nc) = (&ws.chain.mc, 6 + n);
-        // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B, Bᵀ M₁₂, M₂₁ B, M₂₂ (loops: the
-        // blocks are small, and a general product's set-up costs more than the arithmetic).
-        let mb = &mut ws.mb; // M_c[:, 0..6] B, row-major (6 + n) × nb
-        refill(mb, nc * nb, 0.0);
-        for i in 0..nc {
+        let (b, mbb, bias) = (&ws.b, &mut ws.mbb, &mut ws.bias);
+        let (m11, m12) = (&ws.chain.m11, &ws.chain.m12);
+        // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B here, Bᵀ M₁₂, M₂₁ B and M₂₂ below
+        // when dense (loops: the blocks are small, and a general product's set-up costs more
+        // than the arithmetic).
+        let mb = &mut ws.mb; // M₁₁ B, row-major 6 × nb
+        refill(mb, 6 * nb, 0.0);
+        for i in 0..6 {
             for j in 0..nb {
-                mb[i * nb + j] = (0..6).map(|k| mc[i * nc + k] * b[k * nb + j]).sum::<f64>();
+                mb[i * nb + j] = (0..6).map(|k| m11[i][k] * b[k * nb + j]).sum::<f64>();
             }
         }
         for i in 0..nb {
             for j in 0..nb {
-                mass[i * ns + j] += (0..6).map(|k| b[k * nb + i] * mb[k * nb + j]).sum::<f64>();
-            }
-            for c in 0..n {
-                // Bᵀ M₁₂ = (M₂₁ B)ᵀ.
-                let v = mb[(6 + c) * nb + i];
-                mass[i * ns + nb + c] += v;
-                mass[(nb + c) * ns + i] += v;
+                mbb[i * nb + j] += (0..6).map(|k| b[k * nb + i] * mb[k * nb + j]).sum::<f64>();
             }
         }
-        for r in 0..n {
-            for c in 0..n {
-                mass[(nb + r) * ns + nb + c] += mc[(6 + r) * nc + 6 + c];
-            }
-        }
-        // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ.
+        // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ
+        // (M₂₁ has the planar columns 0, 1 and 5 only).
         let cb = &mut ws.cb;
         cb.clear();
         cb.extend_from_slice(&ws.chain.bc);
-        for i in 0..nc {
-            cb[i] += (0..6).map(|k| mc[i * nc + k] * a_bias[k]).sum::<f64>();
+        for i in 0..6 {
+            cb[i] += (0..6).map(|k| m11[i][k] * a_bias[k]).sum::<f64>();
+        }
+        for (c, col) in m12.iter().enumerate() {
+            cb[6 + c] += col[0] * a_bias[0] + col[1] * a_bias[1] + col[2] * a_bias[5];
         }
         for j in 0..nb {
             bias[j] += (0..6).map(|i| b[i * nb + j] * cb[i]).sum::<f64>();
         }
         for c in 0..n {
             bias[nb + c] += cb[6 + c];
+        }
+        if dense {
+            self.dense_mass(ws);
         }
         // Applied forces.
         let force = &mut ws.force;
@@ -434,6 +439,32 @@ impl Coupled {
         }
     }
 
+    /// The whole mass matrix into `ws.mass` (ns × ns): M_bb, Bᵀ M₁₂ and its transpose, M₂₂.
+    fn dense_mass(&self, ws: &mut Workspace) {
+        let (nb, n) = (self.rate_offset(), self.panels());
+        let (ns, nc) = (nb + n, 6 + n);
+        let (b, mc, mass) = (&ws.b, &ws.chain.mc, &mut ws.mass);
+        refill(mass, ns * ns, 0.0);
+        for i in 0..nb {
+            mass[i * ns..i * ns + nb].copy_from_slice(&ws.mbb[i * nb..(i + 1) * nb]);
+        }
+        for c in 0..n {
+            for i in 0..nb {
+                // Bᵀ M₁₂ = (M₂₁ B)ᵀ.
+                let v = (0..6)
+                    .map(|k| mc[(6 + c) * nc + k] * b[k * nb + i])
+                    .sum::<f64>();
+                mass[i * ns + nb + c] += v;
+                mass[(nb + c) * ns + i] += v;
+            }
+        }
+        for r in 0..n {
+            for c in 0..n {
+                mass[(nb + r) * ns + nb + c] += mc[(6 + r) * nc + 6 + c];
+            }
+        }
+    }
+
     /// C (α − α(0)) per cable loop, rad.
     pub fn cable_mismatch(&self, alpha: &[f64]) -> Vec<f64> {
         (1..self.panels())
@@ -454,8 +485,8 @@ impl Coupled {
     fn base_terms(&self, s: &View<'_>, ws: &mut Workspace) {
         let inv = &self.base.invariants;
         let (h, m) = (self.hub_dof(), self.modes());
-        let ns = self.speeds();
-        let (at, mass, bias) = (&ws.at, &mut ws.mass, &mut ws.bias);
+        let ns = h + m; // the stride of M_bb
+        let (at, mass, bias) = (&ws.at, &mut ws.mbb, &mut ws.bias);
         for a in 0..m {
             for c in 0..m {
                 mass[(h + a) * ns + h + c] += inv.mee[(a, c)];
@@ -514,8 +545,17 @@ impl Coupled {
     }
 
     /// The chain's block matrix M_c over [A; Ω̇; α̈] and its bias b_c for H's angular
-    /// velocity `omega` (hinge components), all in hinge components, into `cw`.
-    fn chain_blocks(&self, alpha: &[f64], alpha_dot: &[f64], omega: Vec3, cw: &mut ChainWork) {
+    /// velocity `omega` (hinge components), all in hinge components, into `cw`: M₁₁ and the
+    /// coupling columns M₁₂ always, the dense M_c when `dense` (the O(N) elimination of
+    /// [`super::articulated`] does without M₂₂).
+    fn chain_blocks(
+        &self,
+        alpha: &[f64],
+        alpha_dot: &[f64],
+        omega: Vec3,
+        cw: &mut ChainWork,
+        dense: bool,
+    ) {
         let ch = &self.chain;
         let n = ch.len();
         cw.configure(ch, alpha, alpha_dot);
@@ -538,8 +578,8 @@ impl Coupled {
             ah = ah - l * (wi * wi);
         }
         let nc = 6 + n;
-        let (mc, bc) = (&mut cw.mc, &mut cw.bc);
-        refill(mc, nc * nc, 0.0);
+        refill(&mut cw.m12, n, [0.0; 3]);
+        let bc = &mut cw.bc;
         refill(bc, nc, 0.0);
         // Outboard sums, tip to root: mass, first moment, rotational inertia about ẑ and the
         // bias forces' resultant and moment about H.
@@ -568,29 +608,30 @@ impl Coupled {
             let bl = s1 - hl * mt; // Σ m_j (c_j − h_l)
             let al = mzz - 2.0 * hl.dot(s1) + mt * hl.dot(hl) + iz; // Σ m_j|c_j − h_l|² + I_z
             let dl = d(i);
+            // Column 6 + l of M_c: a force in the hinge plane and a moment about ẑ.
             let fcol = z.cross(bl) * dl;
-            let mcol = z * (dl * (al + hl.dot(bl)));
-            for r in 0..3 {
-                mc[r * nc + 6 + i] = fcol.get(r);
-                mc[(6 + i) * nc + r] = fcol.get(r);
-                mc[(3 + r) * nc + 6 + i] = mcol.get(r);
-                mc[(6 + i) * nc + 3 + r] = mcol.get(r);
-            }
+            let mcol = dl * (al + hl.dot(bl));
+            cw.m12[i] = [fcol.get(0), fcol.get(1), mcol];
             // d_l ẑ·[Σ (c_j − h_l) × m_j a_j^b + rot_j] = d_l ẑ·(mb − h_l × fb).
             bc[6 + i] = dl * z.dot(mb - hl.cross(fb));
         }
         let st = s1.skew();
+        let m11 = &mut cw.m11;
+        *m11 = [[0.0; 6]; 6];
         for r in 0..3 {
-            mc[r * nc + r] = mt;
+            m11[r][r] = mt;
             for c in 0..3 {
-                mc[r * nc + 3 + c] = -st.get(r, c);
-                mc[(3 + r) * nc + c] = st.get(r, c);
-                mc[(3 + r) * nc + 3 + c] = jc.get(r, c);
+                m11[r][3 + c] = -st.get(r, c);
+                m11[3 + r][c] = st.get(r, c);
+                m11[3 + r][3 + c] = jc.get(r, c);
             }
             bc[r] = fb.get(r);
             bc[3 + r] = mb.get(r);
         }
-        cw.chain_mass(ch);
+        cw.outboard_sums(ch);
+        if dense {
+            cw.dense_blocks();
+        }
     }
 
     /// Panel i's inertia tensor about its centre in hinge components, at absolute angle φ_i.
@@ -619,13 +660,13 @@ impl Coupled {
     /// [`Coupled::evaluate`] with the latch moments of the captured hinges in the forces.
     fn evaluate_captured(&self, y: &[f64], captured: &[bool]) -> Eval {
         let mut ws = Workspace::default();
-        self.assemble_captured(y, captured, &mut ws);
+        self.assemble_captured(y, captured, &mut ws, true);
         ws.to_eval(self)
     }
 
     /// [`Coupled::assemble`] with the latch moments of the captured hinges in the forces.
-    fn assemble_captured(&self, y: &[f64], captured: &[bool], ws: &mut Workspace) {
-        self.assemble(y, ws);
+    fn assemble_captured(&self, y: &[f64], captured: &[bool], ws: &mut Workspace, dense: bool) {
+        self.assemble_parts(y, ws, dense);
         let nb = self.rate_offset();
         let s = self.view(y);
         for j in 0..self.panels() {
@@ -674,6 +715,120 @@ impl Coupled {
         let mut udot = vec![0.0; rhs.len()];
         solve_admissible(|i, j| ev.mass[(i, j)], &rhs, &mut sw, &mut udot);
         udot
+    }
+
+    /// u̇ = Z (ZᵀMZ)⁻¹ Zᵀ (Q − c) for the hinges flagged free, in O(N + m²) per call beyond the
+    /// base block's factorisation (docs/theory.md §2.7), from the parts of
+    /// [`Coupled::assemble_parts`] without the dense mass matrix (`ws.force` holds Q − c).
+    /// With M₁₂ (M_c's coupling columns, planar: rows A_x, A_y, Ω̇_z) and B_p the same rows
+    /// of B, the opening rates' block is eliminated:
+    ///   independent (or elastically tied) hinges, free set F: Y = M₂₂,FF⁻¹ M₂₁,F and
+    ///   y = M₂₂,FF⁻¹ (Q − c)_F by the articulated-body recursion ([`super::articulated`]),
+    ///   (M_bb − B_pᵀ M₁₂,F Y B_p) u̇_b = (Q − c)_b − B_pᵀ M₁₂,F y,   α̈_F = y − Y B_p u̇_b;
+    ///   an ideal cable (α̇ = r ẇ, r = (1, 2, 2, …)): the one speed ẇ joins the base's with
+    ///   rᵀ M₂₂ r (M₂₂ r by prefix and suffix sums, [`super::articulated::mass_times`]) and
+    ///   the coupling B_pᵀ M₁₂ r; α̈ = r ẇ.
+    /// A failed factorisation (a non-finite state) gives NaN, which stops the run.
+    fn eliminate_chain(&self, ws: &Workspace, sw: &mut SolveWork, free: &[bool], udot: &mut [f64]) {
+        let (nb, n) = (self.rate_offset(), self.panels());
+        let cw = &ws.chain;
+        let r = &ws.force;
+        let (rb, ra) = r.split_at(nb);
+        // Rows A_x, A_y, Ω̇_z of B (6 × nb).
+        let bp = |k: usize, j: usize| ws.b[[0, 1, 5][k] * nb + j];
+        let fw = &mut sw.fast;
+        let cable = self.sync == Synchronisation::IdealCable && free.iter().any(|f| *f);
+        let k = nb + usize::from(cable);
+        let a = &mut sw.zmz;
+        refill(a, k * k, 0.0);
+        for i in 0..nb {
+            a[i * k..i * k + nb].copy_from_slice(&ws.mbb[i * nb..(i + 1) * nb]);
+        }
+        refill(&mut sw.w, k, 0.0);
+        sw.w[..nb].copy_from_slice(rb);
+        refill(&mut fw.y[0], n, 0.0);
+        if cable {
+            let rc = &mut fw.y[1];
+            refill(rc, n, 2.0);
+            rc[0] = 1.0;
+            fw.hinges.clear();
+            fw.hinges
+                .extend(cw.hinges[..n].iter().map(|h| [h.get(0), h.get(1)]));
+            let (mr, rest) = fw.y.split_at_mut(1);
+            articulated::mass_times(&fw.hinges, &cw.bsum, &cw.asum, &rest[0], &mut mr[0]);
+            let rc = &fw.y[1];
+            let srr = dot(rc, &fw.y[0]);
+            let mut g = [0.0; 3];
+            for (col, x) in cw.m12.iter().zip(rc) {
+                for q in 0..3 {
+                    g[q] += col[q] * x;
+                }
+            }
+            for j in 0..nb {
+                let v = (0..3).map(|q| bp(q, j) * g[q]).sum::<f64>();
+                a[nb * k + j] = v;
+                a[j * k + nb] = v;
+            }
+            a[nb * k + nb] = srr;
+            sw.w[nb] = dot(rc, ra);
+        } else {
+            fw.panels.clear();
+            fw.panels.extend((0..n).map(|i| articulated::PlanarPanel {
+                mass: self.chain.panels[i].mass,
+                inertia: self.chain.panels[i].inertia,
+                centre: [cw.centres[i].get(0), cw.centres[i].get(1)],
+                hinge: [cw.hinges[i].get(0), cw.hinges[i].get(1)],
+            }));
+            if !fw.art.factor(&fw.panels, free) {
+                udot.fill(f64::NAN);
+                return;
+            }
+            // y[0] = M₂₂⁻¹ (Q − c)_α, y[1 + q] = M₂₂⁻¹ M₂₁[:, q].
+            fw.art.solve(ra, &mut fw.y[0]);
+            for q in 0..3 {
+                fw.tau.clear();
+                fw.tau.extend(cw.m12.iter().map(|col| col[q]));
+                refill(&mut fw.y[1 + q], n, 0.0);
+                fw.art.solve(&fw.tau, &mut fw.y[1 + q]);
+            }
+            // Δ = M₁₂ Y (3 × 3) and M₁₂ y.
+            let mut delta = [[0.0; 3]; 3];
+            let mut my = [0.0; 3];
+            for (c, col) in cw.m12.iter().enumerate() {
+                for q in 0..3 {
+                    my[q] += col[q] * fw.y[0][c];
+                    for p in 0..3 {
+                        delta[q][p] += col[q] * fw.y[1 + p][c];
+                    }
+                }
+            }
+            for i in 0..nb {
+                let di: [f64; 3] =
+                    std::array::from_fn(|p| (0..3).map(|q| bp(q, i) * delta[q][p]).sum::<f64>());
+                for j in 0..nb {
+                    a[i * k + j] -= (0..3).map(|p| di[p] * bp(p, j)).sum::<f64>();
+                }
+                sw.w[i] -= (0..3).map(|q| bp(q, i) * my[q]).sum::<f64>();
+            }
+        }
+        if !cholesky_in_place(a, k) {
+            udot.fill(f64::NAN);
+            return;
+        }
+        cholesky_solve(a, k, &mut sw.w);
+        udot[..nb].copy_from_slice(&sw.w[..nb]);
+        if cable {
+            let wd = sw.w[nb];
+            for (u, rc) in udot[nb..].iter_mut().zip(&fw.y[1]) {
+                *u = rc * wd;
+            }
+        } else {
+            let ap: [f64; 3] =
+                std::array::from_fn(|q| (0..nb).map(|j| bp(q, j) * sw.w[j]).sum::<f64>());
+            for c in 0..n {
+                udot[nb + c] = fw.y[0][c] - (0..3).map(|q| fw.y[1 + q][c] * ap[q]).sum::<f64>();
+            }
+        }
     }
 
     /// The root wrench and cable torques for accelerations u̇.
@@ -848,15 +1003,12 @@ impl Coupled {
     pub fn rhs_captured(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
         let np = self.positions();
         WORKSPACE.with_borrow_mut(|(ws, sw)| {
-            self.assemble_captured(y, captured, ws);
-            self.admissible_into(free, &mut sw.z);
+            self.assemble_captured(y, captured, ws, false);
             // Q − c, in place of Q.
             for (f, c) in ws.force.iter_mut().zip(&ws.bias) {
                 *f -= c;
             }
-            let ns = self.speeds();
-            let mass = &ws.mass;
-            solve_admissible(|i, j| mass[i * ns + j], &ws.force, sw, &mut dy[np..]);
+            self.eliminate_chain(ws, sw, free, &mut dy[np..]);
         });
         let s = self.view(y);
         let (h, m) = (self.hub_dof(), self.modes());
@@ -1041,11 +1193,12 @@ struct Workspace {
     a_bias: [f64; 6],
     /// The chain's blocks.
     chain: ChainWork,
-    /// M (ns × ns), c and Q.
+    /// M (ns × ns, only when asked for), its base block M_bb (nb × nb), c and Q.
     mass: Vec<f64>,
+    mbb: Vec<f64>,
     bias: Vec<f64>,
     force: Vec<f64>,
-    /// M_c[:, 0..6] B ((6 + N) × nb) and b_c + M_c [a_b; 0].
+    /// M₁₁ B (6 × nb) and b_c + M_c [a_b; 0].
     mb: Vec<f64>,
     cb: Vec<f64>,
 }
@@ -1086,9 +1239,13 @@ struct ChainWork {
     inertia: Vec<Mat3>,
     cdot: Vec<Vec3>,
     cdd: Vec<Vec3>,
-    /// M_c ((6 + N)²) and b_c.
+    /// M_c ((6 + N)², only when asked for) and b_c.
     mc: Vec<f64>,
     bc: Vec<f64>,
+    /// M_c's upper left 6 × 6 block M₁₁ (the chain as one rigid body at H).
+    m11: [[f64; 6]; 6],
+    /// Column 6 + l of M_c (rows 0, 1 and 5; its other rows are zero): hinge l's coupling.
+    m12: Vec<[f64; 3]>,
     /// Outboard sums of the hinges (see [`ChainWork::chain_mass`]).
     s0: Vec<f64>,
     bsum: Vec<P2>,
@@ -1137,18 +1294,16 @@ impl ChainWork {
         }
     }
 
-    /// The chain's mass matrix over α̈ into M_c's lower right block: [`Chain::mass_matrix`]
-    /// for the held hub, in the same arithmetic. With the outboard sums about hinge l,
-    /// S0_l = Σ_{i≥l} m_i, B_l = Σ m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i (tip to root
-    /// by the parallel-axis shift), for k ≤ l
+    /// The outboard sums about hinge l that the chain's mass matrix over α̈ (M_c's lower
+    /// right block, [`Chain::mass_matrix`] for the held hub, in the same arithmetic) is made
+    /// of: S0_l = Σ_{i≥l} m_i, B_l = Σ m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i (tip to
+    /// root by the parallel-axis shift); for k ≤ l
     ///   M_{α_k α_l} = d_k d_l [A_l + (H_l − H_k)·B_l].
-    fn chain_mass(&mut self, ch: &Chain) {
+    fn outboard_sums(&mut self, ch: &Chain) {
         let nn = ch.len();
-        let nc = 6 + nn;
         let p2 = |v: Vec3| [v.get(0), v.get(1)];
         let sub = |a: P2, b: P2| [a[0] - b[0], a[1] - b[1]];
         let dot = |a: P2, b: P2| a[0] * b[0] + a[1] * b[1];
-        let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
         refill(&mut self.s0, nn, 0.0);
         refill(&mut self.bsum, nn, [0.0; 2]);
         refill(&mut self.asum, nn, 0.0);
@@ -1166,6 +1321,27 @@ impl ChainWork {
             self.s0[l] = s0n;
             self.bsum[l] = bn;
             self.asum[l] = an;
+        }
+    }
+
+    /// The dense M_c ((6 + N)², row-major) from M₁₁, the coupling columns and the outboard
+    /// sums (O(N²): [`Coupled::evaluate`]'s users; the right-hand side does without).
+    fn dense_blocks(&mut self) {
+        let nn = self.m12.len();
+        let nc = 6 + nn;
+        let p2 = |v: Vec3| [v.get(0), v.get(1)];
+        let sub = |a: P2, b: P2| [a[0] - b[0], a[1] - b[1]];
+        let dot = |a: P2, b: P2| a[0] * b[0] + a[1] * b[1];
+        let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
+        refill(&mut self.mc, nc * nc, 0.0);
+        for r in 0..6 {
+            self.mc[r * nc..r * nc + 6].copy_from_slice(&self.m11[r]);
+        }
+        for (i, [fx, fy, mz]) in self.m12.iter().copied().enumerate() {
+            for (r, v) in [(0, fx), (1, fy), (5, mz)] {
+                self.mc[r * nc + 6 + i] = v;
+                self.mc[(6 + i) * nc + r] = v;
+            }
         }
         for l in 0..nn {
             let hl = p2(self.hinges[l]);
@@ -1227,6 +1403,19 @@ struct SolveWork {
     zmz: Vec<f64>,
     /// Zᵀb, overwritten by ẇ.
     w: Vec<f64>,
+    /// The O(N) elimination's buffers ([`Coupled::eliminate_chain`]).
+    fast: FastWork,
+}
+
+/// [`Coupled::eliminate_chain`]'s buffers.
+#[derive(Debug, Default)]
+struct FastWork {
+    art: articulated::Articulated,
+    panels: Vec<articulated::PlanarPanel>,
+    hinges: Vec<[f64; 2]>,
+    tau: Vec<f64>,
+    /// M₂₂⁻¹ (Q − c)_α and M₂₂⁻¹ M₂₁'s three columns (or M₂₂ r and r with a cable).
+    y: [Vec<f64>; 4],
 }
 
 /// u = Z (ZᵀMZ)⁻¹ Zᵀ b into `u`, with M given by its entries `m(i, j)` and Z in `work.z`.

@@ -4,6 +4,7 @@
 //! structure ([`planar`]), and the run with latch events,
 //! samples, its status and warnings ([`simulate`]).
 
+pub(crate) mod articulated;
 pub mod attitude;
 pub mod base;
 pub mod chain;

@@ -289,3 +289,70 @@ fn ideal_cable_latch_time_equals_the_energy_quadrature() {
         assert!((a - h.latch_angle).abs() < 1e-9, "{a} vs {}", h.latch_angle);
     }
 }
+
+/// The right-hand side eliminates the opening angles in O(N) (the articulated-body recursion,
+/// or the cable's one speed; docs/theory.md §2.7); `solve_captured` solves the dense
+/// Kane system over every speed. The two formulations give the same accelerations at
+/// arbitrary states: free and held hub, independent hinges with any set locked, ideal and
+/// elastic cables, captured compliant latches, 3 and 12 panels.
+#[test]
+fn linear_time_elimination_equals_the_dense_solve() {
+    use flexcraft::deploy::coupled::CompliantLatch;
+    let mut seed = 0x9e3779b97f4a7c15_u64;
+    let mut rand = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let mut checked = 0;
+    for (panels, motion) in [(3, "free"), (3, "fixed"), (12, "free")] {
+        let sc = scenario("seed.toml", |s| {
+            s.replace("panels = 3", &format!("panels = {panels}"))
+                .replace("motion = \"free\"", &format!("motion = \"{motion}\""))
+        });
+        let mut c = coupled(&sc, BaseKind::Flexible { modes: Some(10) });
+        let (np, n) = (c.positions(), c.panels());
+        assert_eq!(n, panels);
+        for sync in [
+            Synchronisation::None,
+            Synchronisation::IdealCable,
+            Synchronisation::ElasticCable(50.0),
+        ] {
+            c.sync = sync;
+            for pattern in 0..4usize {
+                let free: Vec<bool> = (0..n)
+                    .map(|i| pattern == 0 || (i + pattern) % 3 != 0)
+                    .collect();
+                let captured: Vec<bool> = (0..n).map(|i| pattern == 3 && i % 2 == 0).collect();
+                c.latch = (pattern == 3).then(|| CompliantLatch {
+                    stiffness: vec![1e5; n],
+                    damping: vec![300.0; n],
+                });
+                let mut y = c.initial_state();
+                for (i, v) in y.iter_mut().enumerate() {
+                    // Deformed, turning and moving: O(1) angles and rates, small η.
+                    let scale = if i < np { 0.3 } else { 0.2 };
+                    *v += scale * rand();
+                }
+                if motion == "free" {
+                    let q = &mut y[3..7];
+                    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    q.iter_mut().for_each(|x| *x /= norm);
+                }
+                let mut dy = vec![0.0; y.len()];
+                c.rhs_captured(&y, &free, &captured, &mut dy);
+                let (_, sol) = c.solve_captured(&y, &free, &captured);
+                let scale = sol.udot.iter().map(|x| x.abs()).fold(0.0, f64::max);
+                for (k, (a, b)) in dy[np..].iter().zip(&sol.udot).enumerate() {
+                    assert!(
+                        (a - b).abs() <= 1e-10 * scale,
+                        "{panels} panels, {motion} hub, {sync:?}, pattern {pattern}: u̇[{k}] {a} vs dense {b}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 36);
+}
