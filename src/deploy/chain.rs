@@ -245,7 +245,7 @@ impl Chain {
     }
 
     /// ∂φ_j/∂α_k for j ≥ k.
-    fn d(k: usize) -> f64 {
+    pub(crate) fn d(k: usize) -> f64 {
         // k is 0-based here: hinge k+1, d = (−1)^(k+1).
         if k % 2 == 0 {
             -1.0

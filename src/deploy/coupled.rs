@@ -412,6 +412,10 @@ impl Coupled {
         }
         if dense {
             self.dense_mass(ws);
+        } else {
+            // Nothing of an earlier dense evaluation (perhaps of another model) stays readable.
+            ws.mass.clear();
+            ws.chain.mc.clear();
         }
         // Applied forces.
         let force = &mut ws.force;
@@ -481,7 +485,7 @@ impl Coupled {
     }
 
     /// The base's own mass matrix and velocity terms over [v, ω, η̇] (see [`super::inertia`]),
-    /// added to `ws.mass` and `ws.bias` (`ws.at` holds the invariants at η).
+    /// added to `ws.mbb` and `ws.bias` (`ws.at` holds the invariants at η).
     fn base_terms(&self, s: &View<'_>, ws: &mut Workspace) {
         let inv = &self.base.invariants;
         let (h, m) = (self.hub_dof(), self.modes());
@@ -1246,7 +1250,7 @@ struct ChainWork {
     m11: [[f64; 6]; 6],
     /// Column 6 + l of M_c (rows 0, 1 and 5; its other rows are zero): hinge l's coupling.
     m12: Vec<[f64; 3]>,
-    /// Outboard sums of the hinges (see [`ChainWork::chain_mass`]).
+    /// Outboard sums of the hinges (see [`ChainWork::outboard_sums`]).
     s0: Vec<f64>,
     bsum: Vec<P2>,
     asum: Vec<f64>,
