@@ -108,7 +108,8 @@ pub struct View<'a> {
 /// Everything computed at one state.
 #[derive(Debug, Clone)]
 pub struct Eval {
-    /// System mass matrix over the speeds.
+    /// System mass matrix over the speeds (0 × 0 from the per-step load path, which does
+    /// without it).
     pub mass: Mat<f64>,
     /// Velocity terms c.
     pub bias: Vec<f64>,
@@ -124,7 +125,7 @@ pub struct Eval {
     pub b: Mat<f64>,
     /// [A; Ω̇] of H for zero accelerations (hinge components).
     pub a_bias: [f64; 6],
-    /// The chain's block matrix M_c ((6 + N)²) and bias b_c.
+    /// The chain's block matrix M_c ((6 + N)²; 0 × 0 from the per-step load path) and bias b_c.
     pub mc: Mat<f64>,
     /// The chain's bias b_c.
     pub bc: Vec<f64>,
@@ -723,7 +724,7 @@ impl Coupled {
 
     /// u̇ = Z (ZᵀMZ)⁻¹ Zᵀ (Q − c) for the hinges flagged free, in O(N + m²) per call beyond the
     /// base block's factorisation (docs/theory.md §2.7), from the parts of
-    /// [`Coupled::assemble_parts`] without the dense mass matrix (`ws.force` holds Q − c).
+    /// [`Coupled::assemble_parts`] without the dense mass matrix; `r` is Q − c.
     /// With M₁₂ (M_c's coupling columns, planar: rows A_x, A_y, Ω̇_z) and B_p the same rows
     /// of B, the opening rates' block is eliminated:
     ///   independent (or elastically tied) hinges, free set F: Y = M₂₂,FF⁻¹ M₂₁,F and
@@ -733,10 +734,16 @@ impl Coupled {
     ///   rᵀ M₂₂ r (M₂₂ r by prefix and suffix sums, [`super::articulated::mass_times`]) and
     ///   the coupling B_pᵀ M₁₂ r; α̈ = r ẇ.
     /// A failed factorisation (a non-finite state) gives NaN, which stops the run.
-    fn eliminate_chain(&self, ws: &Workspace, sw: &mut SolveWork, free: &[bool], udot: &mut [f64]) {
+    fn eliminate_chain(
+        &self,
+        ws: &Workspace,
+        r: &[f64],
+        sw: &mut SolveWork,
+        free: &[bool],
+        udot: &mut [f64],
+    ) {
         let (nb, n) = (self.rate_offset(), self.panels());
         let cw = &ws.chain;
-        let r = &ws.force;
         let (rb, ra) = r.split_at(nb);
         // Rows A_x, A_y, Ω̇_z of B (6 × nb).
         let bp = |k: usize, j: usize| ws.b[[0, 1, 5][k] * nb + j];
@@ -832,6 +839,91 @@ impl Coupled {
             for c in 0..n {
                 udot[nb + c] = fw.y[0][c] - (0..3).map(|q| fw.y[1 + q][c] * ap[q]).sum::<f64>();
             }
+        }
+    }
+
+    /// [`Coupled::solve_captured`] through the O(N) elimination (docs/theory.md §2.7), for
+    /// the loads a run tracks at every step: the same accelerations, root wrench and cable
+    /// torques, to rounding. The [`Eval`] returned has no dense `mass` and `mc` (0 × 0).
+    pub fn solve_captured_fast(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+    ) -> (Eval, Solution) {
+        WORKSPACE.with_borrow_mut(|(ws, sw)| {
+            self.assemble_captured(y, captured, ws, false);
+            let mut qc = std::mem::take(&mut sw.fast.qc);
+            qc.clear();
+            qc.extend(ws.force.iter().zip(&ws.bias).map(|(f, c)| f - c));
+            let mut udot = vec![0.0; self.speeds()];
+            self.eliminate_chain(ws, &qc, sw, free, &mut udot);
+            let sol = self.loads_from_blocks(y, ws, &qc, udot, free);
+            sw.fast.qc = qc;
+            (ws.to_eval(self), sol)
+        })
+    }
+
+    /// [`Coupled::loads`] from the blocks M₁₁ and M₁₂ of `ws` (no dense matrix): with
+    /// acc = [A; Ω̇; α̈] of H, W = M₁₁ [A; Ω̇] + M₁₂ α̈ + b₁; an ideal cable's torques from the
+    /// hinge rows of M u̇ − (Q − c) = M₂₁ B u̇_b + M₂₂ α̈ − (Q − c)_α (M₂₂ α̈ in O(N),
+    /// [`articulated::mass_times`]).
+    fn loads_from_blocks(
+        &self,
+        y: &[f64],
+        ws: &Workspace,
+        qc: &[f64],
+        udot: Vec<f64>,
+        free: &[bool],
+    ) -> Solution {
+        let (nb, n) = (self.rate_offset(), self.panels());
+        let (cw, b) = (&ws.chain, &ws.b);
+        let mut acc = vec![0.0; 6 + n];
+        for i in 0..6 {
+            acc[i] = ws.a_bias[i] + (0..nb).map(|j| b[i * nb + j] * udot[j]).sum::<f64>();
+        }
+        acc[6..].copy_from_slice(&udot[nb..]);
+        let mut w: [f64; 6] =
+            std::array::from_fn(|i| cw.bc[i] + (0..6).map(|k| cw.m11[i][k] * acc[k]).sum::<f64>());
+        for (col, a) in cw.m12.iter().zip(&acc[6..]) {
+            w[0] += col[0] * a;
+            w[1] += col[1] * a;
+            w[5] += col[2] * a;
+        }
+        let f = ws.frame.apply(Vec3::new(w[0], w[1], w[2]));
+        let mo = ws.frame.apply(Vec3::new(w[3], w[4], w[5]));
+        let cable_torque = match self.sync {
+            Synchronisation::None => Vec::new(),
+            Synchronisation::ElasticCable(kc) => self
+                .cable_mismatch(self.view(y).alpha)
+                .iter()
+                .map(|x| kc * x)
+                .collect(),
+            Synchronisation::IdealCable => {
+                if free.iter().any(|f| *f) {
+                    // B_p u̇_b: H's in-plane acceleration less its bias.
+                    let bu = [0, 1, 5].map(|i| acc[i] - ws.a_bias[i]);
+                    let hinges: Vec<[f64; 2]> = cw.hinges[..n]
+                        .iter()
+                        .map(|h| [h.get(0), h.get(1)])
+                        .collect();
+                    let mut r = vec![0.0; n];
+                    articulated::mass_times(&hinges, &cw.bsum, &cw.asum, &acc[6..], &mut r);
+                    for (i, ri) in r.iter_mut().enumerate() {
+                        let col = cw.m12[i];
+                        *ri += col[0] * bu[0] + col[1] * bu[1] + col[2] * bu[2] - qc[nb + i];
+                    }
+                    least_squares_multipliers(&self.cable_rows(), &r)
+                } else {
+                    vec![0.0; n.saturating_sub(1)]
+                }
+            }
+        };
+        Solution {
+            udot,
+            root_wrench: (f, mo),
+            cable_torque,
+            hinge_acc: acc,
         }
     }
 
@@ -1012,7 +1104,7 @@ impl Coupled {
             for (f, c) in ws.force.iter_mut().zip(&ws.bias) {
                 *f -= c;
             }
-            self.eliminate_chain(ws, sw, free, &mut dy[np..]);
+            self.eliminate_chain(ws, &ws.force, sw, free, &mut dy[np..]);
         });
         let s = self.view(y);
         let (h, m) = (self.hub_dof(), self.modes());
@@ -1212,8 +1304,16 @@ impl Workspace {
     fn to_eval(&self, c: &Coupled) -> Eval {
         let (ns, nb, nc) = (c.speeds(), c.rate_offset(), 6 + c.panels());
         let cw = &self.chain;
+        // Empty when the evaluation did without the dense blocks.
+        let dense = |v: &[f64], n: usize| {
+            if v.len() == n * n {
+                Mat::from_fn(n, n, |i, j| v[i * n + j])
+            } else {
+                Mat::zeros(0, 0)
+            }
+        };
         Eval {
-            mass: Mat::from_fn(ns, ns, |i, j| self.mass[i * ns + j]),
+            mass: dense(&self.mass, ns),
             bias: self.bias.clone(),
             force: self.force.clone(),
             at: self.at.clone(),
@@ -1221,7 +1321,7 @@ impl Workspace {
             hinge: self.hinge,
             b: Mat::from_fn(6, nb, |i, j| self.b[i * nb + j]),
             a_bias: self.a_bias,
-            mc: Mat::from_fn(nc, nc, |i, j| cw.mc[i * nc + j]),
+            mc: dense(&cw.mc, nc),
             bc: cw.bc.clone(),
             centres: cw.centres.clone(),
             hinge_points: cw.hinges.clone(),
@@ -1420,6 +1520,8 @@ struct FastWork {
     tau: Vec<f64>,
     /// M₂₂⁻¹ (Q − c)_α and M₂₂⁻¹ M₂₁'s three columns (or M₂₂ r and r with a cable).
     y: [Vec<f64>; 4],
+    /// Q − c ([`Coupled::solve_captured_fast`]).
+    qc: Vec<f64>,
 }
 
 /// u = Z (ZᵀMZ)⁻¹ Zᵀ b into `u`, with M given by its entries `m(i, j)` and Z in `work.z`.
