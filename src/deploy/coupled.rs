@@ -655,18 +655,16 @@ impl Coupled {
     }
 
     /// [`Coupled::solve`] with the compliant latches of the hinges flagged `captured` acting.
+    /// The accelerations come from the dense system over every speed (the reference the
+    /// O(N) elimination of [`Coupled::solve_captured_fast`] is tested against).
     pub fn solve_captured(&self, y: &[f64], free: &[bool], captured: &[bool]) -> (Eval, Solution) {
-        let ev = self.evaluate_captured(y, captured);
-        let udot = self.accelerations(&ev, free);
-        let sol = self.loads(y, &ev, udot, free);
-        (ev, sol)
-    }
-
-    /// [`Coupled::evaluate`] with the latch moments of the captured hinges in the forces.
-    fn evaluate_captured(&self, y: &[f64], captured: &[bool]) -> Eval {
         let mut ws = Workspace::default();
         self.assemble_captured(y, captured, &mut ws, true);
-        ws.to_eval(self)
+        let ev = ws.to_eval(self);
+        let udot = self.accelerations(&ev, free);
+        let qc: Vec<f64> = ev.force.iter().zip(&ev.bias).map(|(f, c)| f - c).collect();
+        let sol = self.loads_from_blocks(y, &ws, &qc, udot, free);
+        (ev, sol)
     }
 
     /// [`Coupled::assemble`] with the latch moments of the captured hinges in the forces.
@@ -864,7 +862,8 @@ impl Coupled {
         })
     }
 
-    /// [`Coupled::loads`] from the blocks M₁₁ and M₁₂ of `ws` (no dense matrix): with
+    /// The root wrench and cable torques for accelerations u̇, from the blocks M₁₁ and M₁₂ of
+    /// `ws` (no dense matrix): with
     /// acc = [A; Ω̇; α̈] of H, W = M₁₁ [A; Ω̇] + M₁₂ α̈ + b₁; an ideal cable's torques from the
     /// hinge rows of M u̇ − (Q − c) = M₂₁ B u̇_b + M₂₂ α̈ − (Q − c)_α (M₂₂ α̈ in O(N),
     /// [`articulated::mass_times`]).
@@ -913,54 +912,6 @@ impl Coupled {
                         let col = cw.m12[i];
                         *ri += col[0] * bu[0] + col[1] * bu[1] + col[2] * bu[2] - qc[nb + i];
                     }
-                    least_squares_multipliers(&self.cable_rows(), &r)
-                } else {
-                    vec![0.0; n.saturating_sub(1)]
-                }
-            }
-        };
-        Solution {
-            udot,
-            root_wrench: (f, mo),
-            cable_torque,
-            hinge_acc: acc,
-        }
-    }
-
-    /// The root wrench and cable torques for accelerations u̇.
-    fn loads(&self, y: &[f64], ev: &Eval, udot: Vec<f64>, free: &[bool]) -> Solution {
-        let (nb, n) = (self.rate_offset(), self.panels());
-        // [A; Ω̇] of H, then W = rows 0..6 of M_c [A; Ω̇; α̈] + b_c.
-        let mut acc = vec![0.0; 6 + n];
-        for i in 0..6 {
-            acc[i] = ev.a_bias[i] + (0..nb).map(|j| ev.b[(i, j)] * udot[j]).sum::<f64>();
-        }
-        acc[6..].copy_from_slice(&udot[nb..]);
-        let w: Vec<f64> = (0..6)
-            .map(|i| ev.bc[i] + (0..6 + n).map(|j| ev.mc[(i, j)] * acc[j]).sum::<f64>())
-            .collect();
-        let f = ev.frame.apply(Vec3::new(w[0], w[1], w[2]));
-        let mo = ev.frame.apply(Vec3::new(w[3], w[4], w[5]));
-        let cable_torque = match self.sync {
-            Synchronisation::None => Vec::new(),
-            Synchronisation::ElasticCable(kc) => self
-                .cable_mismatch(self.view(y).alpha)
-                .iter()
-                .map(|x| kc * x)
-                .collect(),
-            Synchronisation::IdealCable => {
-                if free.iter().any(|f| *f) {
-                    // r = (M u̇ + c − Q) on the hinge rows = Cᵀ λ.
-                    let r: Vec<f64> = (0..n)
-                        .map(|i| {
-                            let row = nb + i;
-                            (0..udot.len())
-                                .map(|j| ev.mass[(row, j)] * udot[j])
-                                .sum::<f64>()
-                                + ev.bias[row]
-                                - ev.force[row]
-                        })
-                        .collect();
                     least_squares_multipliers(&self.cable_rows(), &r)
                 } else {
                     vec![0.0; n.saturating_sub(1)]

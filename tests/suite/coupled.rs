@@ -366,12 +366,82 @@ fn linear_time_elimination_equals_the_dense_solve() {
                 };
                 close(&fast.udot, &sol.udot, "u̇");
                 close(&fast.hinge_acc, &sol.hinge_acc, "hinge frame acceleration");
+                // The root wrench and the cable torques by their dense definitions:
+                // W = rows 0..6 of M_c [A; Ω̇; α̈] + b_c (in hub components through the
+                // hinge frame), and λ = (CCᵀ)⁻¹ C r with r = M u̇ + c − Q on the hinge rows.
+                let acc = &sol.hinge_acc;
+                let w: Vec<f64> = (0..6)
+                    .map(|i| ev.bc[i] + (0..6 + n).map(|j| ev.mc[(i, j)] * acc[j]).sum::<f64>())
+                    .collect();
+                let hub = |v: &[f64]| {
+                    ev.frame
+                        .apply(flexcraft::math::Vec3::new(v[0], v[1], v[2]))
+                        .0
+                };
+                let dense_wrench = [hub(&w[..3]), hub(&w[3..])].concat();
                 let wrench = |s: &flexcraft::deploy::coupled::Solution| {
                     let (f, m) = s.root_wrench;
                     [f.0, m.0].concat()
                 };
-                close(&wrench(&fast), &wrench(&sol), "root wrench");
-                close(&fast.cable_torque, &sol.cable_torque, "cable torque");
+                close(&wrench(&fast), &dense_wrench, "root wrench");
+                close(
+                    &wrench(&sol),
+                    &dense_wrench,
+                    "root wrench (dense accelerations)",
+                );
+                if sync == Synchronisation::IdealCable && free.iter().any(|f| *f) {
+                    let ns = sol.udot.len();
+                    let r: Vec<f64> = (0..n)
+                        .map(|i| {
+                            let row = nb + i;
+                            (0..ns)
+                                .map(|j| ev.mass[(row, j)] * sol.udot[j])
+                                .sum::<f64>()
+                                + ev.bias[row]
+                                - ev.force[row]
+                        })
+                        .collect();
+                    // C: loop k ties hinge k to hinge k − 1 (−2 for the first loop, −1 after).
+                    let row = |k: usize| {
+                        let mut c = vec![0.0; n];
+                        c[k] = 1.0;
+                        c[k - 1] = if k == 1 { -2.0 } else { -1.0 };
+                        c
+                    };
+                    let c: Vec<Vec<f64>> = (1..n).map(row).collect();
+                    let dot =
+                        |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+                    // (CCᵀ) λ = C r by Gaussian elimination (tridiagonal, well conditioned).
+                    let k = c.len();
+                    let mut a: Vec<Vec<f64>> = (0..k)
+                        .map(|i| {
+                            let mut row: Vec<f64> = (0..k).map(|j| dot(&c[i], &c[j])).collect();
+                            row.push(dot(&c[i], &r));
+                            row
+                        })
+                        .collect();
+                    for p in 0..k {
+                        for q in p + 1..k {
+                            let f = a[q][p] / a[p][p];
+                            for j in p..=k {
+                                a[q][j] -= f * a[p][j];
+                            }
+                        }
+                    }
+                    let mut lambda = vec![0.0; k];
+                    for p in (0..k).rev() {
+                        let s: f64 = (p + 1..k).map(|j| a[p][j] * lambda[j]).sum();
+                        lambda[p] = (a[p][k] - s) / a[p][p];
+                    }
+                    close(&fast.cable_torque, &lambda, "cable torque");
+                    close(
+                        &sol.cable_torque,
+                        &lambda,
+                        "cable torque (dense accelerations)",
+                    );
+                } else {
+                    close(&fast.cable_torque, &sol.cable_torque, "cable torque");
+                }
                 let flat = |l: Vec<(flexcraft::math::Vec3, flexcraft::math::Vec3)>| {
                     l.iter()
                         .flat_map(|(f, m)| [f.0, m.0].concat())
