@@ -760,11 +760,8 @@ impl Coupled {
             let rc = &mut fw.y[1];
             refill(rc, n, 2.0);
             rc[0] = 1.0;
-            fw.hinges.clear();
-            fw.hinges
-                .extend(cw.hinges[..n].iter().map(|h| [h.get(0), h.get(1)]));
             let (mr, rest) = fw.y.split_at_mut(1);
-            articulated::mass_times(&fw.hinges, &cw.bsum, &cw.asum, &rest[0], &mut mr[0]);
+            articulated::mass_times(&cw.plane_hinges, &cw.bsum, &cw.asum, &rest[0], &mut mr[0]);
             let rc = &fw.y[1];
             let srr = dot(rc, &fw.y[0]);
             let mut g = [0.0; 3];
@@ -902,12 +899,9 @@ impl Coupled {
                 if free.iter().any(|f| *f) {
                     // B_p u̇_b: H's in-plane acceleration less its bias.
                     let bu = [0, 1, 5].map(|i| acc[i] - ws.a_bias[i]);
-                    let hinges: Vec<[f64; 2]> = cw.hinges[..n]
-                        .iter()
-                        .map(|h| [h.get(0), h.get(1)])
-                        .collect();
                     let mut r = vec![0.0; n];
-                    articulated::mass_times(&hinges, &cw.bsum, &cw.asum, &acc[6..], &mut r);
+                    let (h, b, a) = (&cw.plane_hinges, &cw.bsum, &cw.asum);
+                    articulated::mass_times(h, b, a, &acc[6..], &mut r);
                     for (i, ri) in r.iter_mut().enumerate() {
                         let col = cw.m12[i];
                         *ri += col[0] * bu[0] + col[1] * bu[1] + col[2] * bu[2] - qc[nb + i];
@@ -1301,10 +1295,11 @@ struct ChainWork {
     m11: [[f64; 6]; 6],
     /// Column 6 + l of M_c (rows 0, 1 and 5; its other rows are zero): hinge l's coupling.
     m12: Vec<[f64; 3]>,
-    /// Outboard sums of the hinges (see [`ChainWork::outboard_sums`]).
-    s0: Vec<f64>,
+    /// Outboard sums of the hinges (see [`ChainWork::outboard_sums`]) and the hinge points
+    /// H_l in the hinge plane, the form [`articulated::mass_times`] takes them in.
     bsum: Vec<P2>,
     asum: Vec<f64>,
+    plane_hinges: Vec<P2>,
 }
 
 impl ChainWork {
@@ -1351,15 +1346,17 @@ impl ChainWork {
 
     /// The outboard sums about hinge l that the chain's mass matrix over α̈ (M_c's lower
     /// right block, [`Chain::mass_matrix`] for the held hub, in the same arithmetic) is made
-    /// of: S0_l = Σ_{i≥l} m_i, B_l = Σ m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i (tip to
-    /// root by the parallel-axis shift); for k ≤ l
+    /// of: B_l = Σ_{i≥l} m_i (C_i − H_l), A_l = Σ m_i |C_i − H_l|² + I_i (tip to root by the
+    /// parallel-axis shift, with the outboard mass S0_l = Σ_{i≥l} m_i); for k ≤ l
     ///   M_{α_k α_l} = d_k d_l [A_l + (H_l − H_k)·B_l].
     fn outboard_sums(&mut self, ch: &Chain) {
         let nn = ch.len();
         let p2 = |v: Vec3| [v.get(0), v.get(1)];
         let sub = |a: P2, b: P2| [a[0] - b[0], a[1] - b[1]];
         let dot = |a: P2, b: P2| a[0] * b[0] + a[1] * b[1];
-        refill(&mut self.s0, nn, 0.0);
+        self.plane_hinges.clear();
+        self.plane_hinges
+            .extend(self.hinges[..nn].iter().map(|h| p2(*h)));
         refill(&mut self.bsum, nn, [0.0; 2]);
         refill(&mut self.asum, nn, 0.0);
         let (mut s0n, mut bn, mut an) = (0.0, [0.0; 2], 0.0);
@@ -1373,7 +1370,6 @@ impl ChainWork {
                 bn[1] + s0n * dl[1] + p.mass * c[1],
             ];
             s0n += p.mass;
-            self.s0[l] = s0n;
             self.bsum[l] = bn;
             self.asum[l] = an;
         }
@@ -1467,7 +1463,6 @@ struct SolveWork {
 struct FastWork {
     art: articulated::Articulated,
     panels: Vec<articulated::PlanarPanel>,
-    hinges: Vec<[f64; 2]>,
     tau: Vec<f64>,
     /// M₂₂⁻¹ (Q − c)_α and M₂₂⁻¹ M₂₁'s three columns (or M₂₂ r and r with a cable).
     y: [Vec<f64>; 4],
