@@ -1,0 +1,326 @@
+//! A measurement, not a feature: can an exponential integrator step over the seed's ringing
+//! base modes and still be accurate? (docs/bench-coupled.md, "Exponential integrators,
+//! measured".)
+//!
+//! The coupled seed deployment (`examples/seed.toml` with `base_modes` replaced) is
+//! integrated from release to `t_end` with fixed steps h by one of these one-step methods,
+//! all built on the local linearisation of y' = f(y) (f = `Coupled::rhs`, ideal cable, no
+//! hinge locked):
+//!
+//! * `cf4`: the fourth-order commutator-free Magnus method of Blanes & Moan (2006),
+//!   y₁ = exp(h(α₂B₁ + α₁B₂)) exp(h(α₁B₁ + α₂B₂)) y₀, α₁,₂ = ¼ ± √3/6, with B_i the affine
+//!   linearisation [J(ȳ_i), f(ȳ_i) − J(ȳ_i)ȳ_i; 0, 0] at the Gauss nodes t₀ + (½ ∓ √3/6)h;
+//!   the node states ȳ_i come from the linearisation frozen at y₀.
+//! * `mm`: the modified Magnus method (Iserles, BIT 42 (2002) 561–599) about the step's
+//!   midpoint generator B̄ = (B₁ + B₂)/2 with B(t) ≈ B̄ + (t − t½)B′, B′ = √3 (B₂ − B₁)/h:
+//!   y₁ = e^{hB̄} exp(Ω₁) y₀, Ω₁ = ∫₀ʰ (s − h/2) e^{−sB̄} B′ e^{sB̄} ds, the oscillatory
+//!   integral taken exactly from one block-triangular exponential (Van Loan, IEEE TAC 23
+//!   (1978) 395–404). Second order, uniformly in hω.
+//! * `mm-smooth`, `cf4-smooth`: the same, but linearised about the node state with the
+//!   base's elastic coordinates and rates set to zero, so that B(t) carries no ringing.
+//! * `mm-smooth-rich`: `mm-smooth` with one Richardson extrapolation (h and two h/2 steps).
+//!
+//! The error is measured against classical RK4 with a fixed step far below the highest
+//! period (cached in `target/magnus_study/`), and DOPRI5 (the library's explicit
+//! integrator, through `simulate_coupled`) at the given tolerances is measured the same way.
+//! Run: `cargo run --release --example magnus_study -- 20 20 mm-smooth 1 0.5 0.25`
+//! (base modes, t_end, method, steps…); `--dopri 1e-8` adds DOPRI5 at that tolerance.
+
+use faer::{Mat, Scale};
+use flexcraft::deploy::coupled::Coupled;
+use flexcraft::deploy::{simulate_coupled, Deployment, Integrator};
+use flexcraft::Scenario;
+use std::cell::Cell;
+use std::time::Instant;
+
+/// The coupled model as y' = f(y), in scaled coordinates z = D y (η_j scaled by ω_j so that
+/// each oscillator's position and rate have one size: the exponentials stay balanced).
+struct Problem<'a> {
+    c: &'a Coupled,
+    free: Vec<bool>,
+    dim: usize,
+    scale: Vec<f64>,
+    smooth: bool,
+    evaluations: Cell<usize>,
+}
+
+impl Problem<'_> {
+    fn f(&self, y: &[f64]) -> Vec<f64> {
+        let mut dy = vec![0.0; self.dim];
+        self.c.rhs(y, &self.free, &mut dy);
+        self.evaluations.set(self.evaluations.get() + 1);
+        dy
+    }
+
+    fn elastic(&self) -> impl Iterator<Item = usize> + '_ {
+        let (m, np, h) = (self.c.modes(), self.c.positions(), self.c.hub_dof());
+        let e0 = self.c.alpha_offset() - m;
+        (0..m).flat_map(move |k| [e0 + k, np + h + k])
+    }
+
+    /// The affine linearisation at `y` as a (dim + 1)-square generator in z.
+    fn generator(&self, y: &[f64]) -> Mat<f64> {
+        let n = self.dim;
+        let mut ybar = y.to_vec();
+        if self.smooth {
+            for i in self.elastic() {
+                ybar[i] = 0.0;
+            }
+        }
+        let f0 = self.f(&ybar);
+        // Forward differences, one column per coordinate, the step 1e-4 of the scaled size.
+        let mut j = Mat::<f64>::zeros(n, n);
+        for k in 0..n {
+            let d = 1e-4 * (ybar[k] * self.scale[k]).abs().max(1.0) / self.scale[k];
+            let mut yp = ybar.clone();
+            yp[k] += d;
+            let fp = self.f(&yp);
+            for i in 0..n {
+                j[(i, k)] = (fp[i] - f0[i]) / d;
+            }
+        }
+        let mut b = Mat::<f64>::zeros(n + 1, n + 1);
+        for i in 0..n {
+            let mut jy = 0.0;
+            for k in 0..n {
+                b[(i, k)] = self.scale[i] * j[(i, k)] / self.scale[k];
+                jy += j[(i, k)] * ybar[k];
+            }
+            b[(i, n)] = self.scale[i] * (f0[i] - jy);
+        }
+        b
+    }
+
+    fn to_z(&self, y: &[f64]) -> Vec<f64> {
+        let mut z: Vec<f64> = y.iter().zip(&self.scale).map(|(a, s)| a * s).collect();
+        z.push(1.0);
+        z
+    }
+
+    fn to_y(&self, z: &[f64]) -> Vec<f64> {
+        (0..self.dim).map(|i| z[i] / self.scale[i]).collect()
+    }
+}
+
+/// e^A by scaling and squaring with a degree-12 Taylor polynomial (‖A/2^s‖ ≤ 1/4).
+fn expm(a: &Mat<f64>) -> Mat<f64> {
+    let n = a.nrows();
+    let norm = (0..n)
+        .map(|i| (0..n).map(|k| a[(i, k)].abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let s = if norm > 0.25 {
+        (norm / 0.25).log2().ceil() as i32
+    } else {
+        0
+    };
+    let x = a * Scale(0.5f64.powi(s));
+    let id = Mat::<f64>::identity(n, n);
+    let mut e = id.clone();
+    for k in (1..=12).rev() {
+        e = &id + (&x * &e) * Scale(1.0 / k as f64);
+    }
+    for _ in 0..s {
+        e = &e * &e;
+    }
+    e
+}
+
+fn apply(e: &Mat<f64>, z: &[f64]) -> Vec<f64> {
+    (0..z.len())
+        .map(|i| (0..z.len()).map(|k| e[(i, k)] * z[k]).sum())
+        .collect()
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Method {
+    Cf4,
+    Mm,
+}
+
+const SQRT3: f64 = 1.732_050_807_568_877_2;
+
+/// One step of `method` from y.
+fn step(p: &Problem, method: Method, y: &[f64], h: f64) -> Vec<f64> {
+    let z = p.to_z(y);
+    let b0 = p.generator(y);
+    let node = |c: f64| p.to_y(&apply(&expm(&(&b0 * Scale(c * h))), &z));
+    let (c1, c2) = (0.5 - SQRT3 / 6.0, 0.5 + SQRT3 / 6.0);
+    let (b1, b2) = (p.generator(&node(c1)), p.generator(&node(c2)));
+    let z1 = match method {
+        Method::Cf4 => {
+            let (a1, a2) = (0.25 + SQRT3 / 6.0, 0.25 - SQRT3 / 6.0);
+            let first = expm(&(&b1 * Scale(a1 * h) + &b2 * Scale(a2 * h)));
+            let second = expm(&(&b1 * Scale(a2 * h) + &b2 * Scale(a1 * h)));
+            apply(&second, &apply(&first, &z))
+        }
+        Method::Mm => {
+            let n = p.dim + 1;
+            let bbar = (&b1 + &b2) * Scale(0.5);
+            let bp = (&b2 - &b1) * Scale(SQRT3 / h);
+            // exp(h [[B̄, B′, 0], [0, B̄, I], [0, 0, B̄]]): block (1,1) = e^{hB̄}, (1,2) =
+            // ∫ e^{(h−s)B̄} B′ e^{sB̄} ds, (1,3) = ∫ s e^{(h−s)B̄} B′ e^{sB̄} ds.
+            let mut big = Mat::<f64>::zeros(3 * n, 3 * n);
+            for i in 0..n {
+                for k in 0..n {
+                    for blk in 0..3 {
+                        big[(blk * n + i, blk * n + k)] = h * bbar[(i, k)];
+                    }
+                    big[(i, n + k)] = h * bp[(i, k)];
+                }
+                big[(n + i, 2 * n + i)] = h;
+            }
+            let e = expm(&big);
+            let block = |c: usize| Mat::<f64>::from_fn(n, n, |i, k| e[(i, c * n + k)]);
+            let (e11, e12, e13) = (block(0), block(1), block(2));
+            // e^{hB̄} exp(Ω₁) = exp(G e^{−hB̄}) e^{hB̄}, G = e^{hB̄} Ω₁ = (1,3) − h/2 (1,2).
+            let g = &e13 - &e12 * Scale(0.5 * h);
+            let inverse = expm(&(&bbar * Scale(-h)));
+            apply(&expm(&(&g * &inverse)), &apply(&e11, &z))
+        }
+    };
+    p.to_y(&z1)
+}
+
+fn rk4(p: &Problem, y: &mut [f64], h: f64, steps: usize) {
+    let n = y.len();
+    for _ in 0..steps {
+        let k1 = p.f(y);
+        let k2 = p.f(&(0..n).map(|i| y[i] + 0.5 * h * k1[i]).collect::<Vec<_>>());
+        let k3 = p.f(&(0..n).map(|i| y[i] + 0.5 * h * k2[i]).collect::<Vec<_>>());
+        let k4 = p.f(&(0..n).map(|i| y[i] + h * k3[i]).collect::<Vec<_>>());
+        for i in 0..n {
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+}
+
+/// Largest errors: α [rad], α̇ [rad/s], ω·η and η̇ [√kg·m/s].
+fn errors(p: &Problem, y: &[f64], r: &[f64]) -> [f64; 4] {
+    let c = p.c;
+    let (m, n, np) = (c.modes(), c.panels(), c.positions());
+    let (a0, e0, r0) = (c.alpha_offset(), c.alpha_offset() - m, np + c.rate_offset());
+    let max = |it: &mut dyn Iterator<Item = f64>| it.fold(0.0, f64::max);
+    [
+        max(&mut (0..n).map(|k| (y[a0 + k] - r[a0 + k]).abs())),
+        max(&mut (0..n).map(|k| (y[r0 + k] - r[r0 + k]).abs())),
+        max(&mut (0..m).map(|k| ((y[e0 + k] - r[e0 + k]) * p.scale[e0 + k]).abs())),
+        max(&mut (0..m).map(|k| (y[np + c.hub_dof() + k] - r[np + c.hub_dof() + k]).abs())),
+    ]
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let modes: usize = args.first().ok_or("base modes")?.parse()?;
+    let t_end: f64 = args.get(1).ok_or("t_end")?.parse()?;
+    let method = args.get(2).ok_or("method")?.as_str();
+    let mut dopri = Vec::new();
+    let mut hs = Vec::new();
+    let mut it = args[3..].iter();
+    while let Some(a) = it.next() {
+        if a == "--dopri" {
+            dopri.push(it.next().ok_or("--dopri tol")?.parse::<f64>()?);
+        } else {
+            hs.push(a.parse::<f64>()?);
+        }
+    }
+    let text = std::fs::read_to_string("examples/seed.toml")?
+        .replace("base_modes = 6", &format!("base_modes = {modes}"));
+    let sc = Scenario::from_toml_str(&text, "seed.toml")?;
+    let d: Deployment = sc.deployment.clone().ok_or("no deployment")?;
+    let c = d.coupled(&sc.structure)?;
+    let dim = c.positions() + c.speeds();
+    let mut scale = vec![1.0; dim];
+    let e0 = c.alpha_offset() - c.modes();
+    for k in 0..c.modes() {
+        scale[e0 + k] = c.base.omega[k];
+    }
+    let (kind, smooth, richardson) = match method {
+        "cf4" => (Method::Cf4, false, false),
+        "cf4-smooth" => (Method::Cf4, true, false),
+        "mm" => (Method::Mm, false, false),
+        "mm-smooth" => (Method::Mm, true, false),
+        "mm-smooth-rich" => (Method::Mm, true, true),
+        other => return Err(format!("unknown method {other}").into()),
+    };
+    let p = Problem {
+        c: &c,
+        free: vec![true; c.panels()],
+        dim,
+        scale,
+        smooth,
+        evaluations: Cell::new(0),
+    };
+
+    // The reference: RK4 with h = 5e-6 s (h ω_max ≤ 0.03 up to 20 modes), cached.
+    let cache = format!("target/magnus_study/rk4_{modes}_{t_end}.txt");
+    let reference: Vec<f64> = match std::fs::read_to_string(&cache) {
+        Ok(t) => t.lines().map(|l| l.parse()).collect::<Result<_, _>>()?,
+        Err(_) => {
+            let mut y = c.initial_state();
+            let steps = (t_end / 5e-6).round() as usize;
+            rk4(&p, &mut y, t_end / steps as f64, steps);
+            std::fs::create_dir_all("target/magnus_study")?;
+            let lines: Vec<String> = y.iter().map(|v| format!("{v:e}")).collect();
+            std::fs::write(&cache, lines.join("\n"))?;
+            y
+        }
+    };
+    println!("seed, {modes} base modes, t = 0 … {t_end} s; errors against RK4 (h = 5e-6 s)");
+    println!("method | h [s] | steps | f evaluations | CPU [s] | α [rad] | α̇ [rad/s] | ω·η | η̇");
+    for tol in dopri {
+        let run = Deployment {
+            tolerance: tol,
+            end_time: t_end,
+            integrator: Integrator::Explicit,
+            ..d.clone()
+        };
+        let t0 = Instant::now();
+        let (_, r) = simulate_coupled(&sc.structure, &run)?;
+        let secs = t0.elapsed().as_secs_f64();
+        let s = r
+            .samples
+            .iter()
+            .rev()
+            .find(|s| (s.t - t_end).abs() < 1e-9)
+            .ok_or("no sample at t_end")?;
+        let b = s.body.as_ref().ok_or("no body sample")?;
+        let mut y = reference.clone();
+        let a0 = c.alpha_offset();
+        let r0 = c.positions() + c.rate_offset();
+        y[a0..a0 + c.panels()].copy_from_slice(&s.alpha);
+        y[r0..r0 + c.panels()].copy_from_slice(&s.rate);
+        y[e0..e0 + c.modes()].copy_from_slice(&b.eta);
+        let e = errors(&p, &y, &reference);
+        println!(
+            "DOPRI5 tol {tol:e} | adaptive | – | {} | {secs:.2} | {:.1e} | {:.1e} | {:.1e} | (not sampled)",
+            r.evaluations, e[0], e[1], e[2]
+        );
+    }
+    for h0 in hs {
+        let steps = (t_end / h0).round() as usize;
+        let h = t_end / steps as f64;
+        p.evaluations.set(0);
+        let t0 = Instant::now();
+        let mut y = c.initial_state();
+        for _ in 0..steps {
+            y = if richardson {
+                let whole = step(&p, kind, &y, h);
+                let half = step(&p, kind, &step(&p, kind, &y, h / 2.0), h / 2.0);
+                half.iter().zip(&whole).map(|(a, b)| (4.0 * a - b) / 3.0).collect()
+            } else {
+                step(&p, kind, &y, h)
+            };
+        }
+        let secs = t0.elapsed().as_secs_f64();
+        let e = errors(&p, &y, &reference);
+        println!(
+            "{method} | {h} | {steps} | {} | {secs:.2} | {:.1e} | {:.1e} | {:.1e} | {:.1e}",
+            p.evaluations.get(),
+            e[0],
+            e[1],
+            e[2],
+            e[3]
+        );
+    }
+    Ok(())
+}
