@@ -231,9 +231,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dim = c.positions() + c.speeds();
     let mut scale = vec![1.0; dim];
     let e0 = c.alpha_offset() - c.modes();
-    for k in 0..c.modes() {
-        scale[e0 + k] = c.base.omega[k];
-    }
+    scale[e0..e0 + c.modes()].copy_from_slice(&c.base.omega[..c.modes()]);
     let (kind, smooth, richardson) = match method {
         "cf4" => (Method::Cf4, false, false),
         "cf4-smooth" => (Method::Cf4, true, false),
@@ -306,7 +304,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             y = if richardson {
                 let whole = step(&p, kind, &y, h);
                 let half = step(&p, kind, &step(&p, kind, &y, h / 2.0), h / 2.0);
-                half.iter().zip(&whole).map(|(a, b)| (4.0 * a - b) / 3.0).collect()
+                half.iter()
+                    .zip(&whole)
+                    .map(|(a, b)| (4.0 * a - b) / 3.0)
+                    .collect()
             } else {
                 step(&p, kind, &y, h)
             };
