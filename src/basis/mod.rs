@@ -193,5 +193,5 @@ impl Integrals {
 }
 
 /// Relative size below which an integral is quadrature rounding of an exact zero
-/// ([`Integrals::clean`]).
+/// (`Integrals::clean`).
 pub const ROUNDING: f64 = 1e-13;

@@ -1070,7 +1070,7 @@ impl Coupled {
 
 impl Coupled {
     /// The stiff part of the Jacobian ∂f/∂y of [`Coupled::rhs_captured`] into `jac` (zeroed,
-    /// positions + speeds square), for the implicit integrator ([`super::rosenbrock`]).
+    /// positions + speeds square), for the implicit integrator (`super::rosenbrock`).
     ///
     /// f = [ẏ_pos; u̇] with u̇ = Z (ZᵀMZ)⁻¹ Zᵀ (Q − c). Kept exactly: the kinematic rows
     /// (η̇ and α̇ from the speeds, Ṙ = A(q) v, q̇ = ½ q ⊗ ω) and the applied forces' slopes

@@ -1,6 +1,6 @@
 //! Loads and impulses of the coupled model ([`super::coupled`]): the hinge reactions, every
 //! base beam's root loads and tip deflection, the impulses of a latch, and the coupled
-//! model as an [`Engine`] of a deployment run.
+//! model as an `Engine` of a deployment run.
 //!
 //! Hinge reactions (Newton–Euler on the outboard sub-chain, hinge components): with the
 //! panels' inertial accelerations a_i, angular velocities ω_i and accelerations ε_i,

@@ -1,6 +1,6 @@
 //! Deployment of an accordion-folded N-panel array (docs/theory.md §2): the chain's dynamics
-//! ([`chain`]), an adaptive integrator with dense output ([`integrator`]), the latch-event
-//! finder ([`events`]), the swing-back tracker ([`swing`]), the chain of a plate of the 3-D
+//! ([`chain`]), an adaptive integrator with dense output (`integrator`), the latch-event
+//! finder (`events`), the swing-back tracker ([`swing`]), the chain of a plate of the 3-D
 //! structure ([`planar`]), and the run with latch events,
 //! samples, its status and warnings ([`simulate`]).
 
@@ -104,7 +104,7 @@ pub enum LatchModel {
         /// Per hinge, N·m·s/rad.
         damping: Vec<f64>,
         /// How long the run continues after the last capture, s (`None`: the default of
-        /// [`settle_time`]).
+        /// [`settle_time_default`]).
         settle_time: Option<f64>,
     },
 }

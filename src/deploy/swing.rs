@@ -62,7 +62,7 @@ impl SwingTracker {
     }
 
     /// The dense step on (step.t0, t_seen] (hinge i's angle is component `offset + i`),
-    /// scanned at [`SUBDIVISIONS`] evenly spaced points; a swing-back starting in the step
+    /// scanned at `SUBDIVISIONS` evenly spaced points; a swing-back starting in the step
     /// has its first time located on the dense output.
     pub fn scan(&mut self, step: &DenseStep, offset: usize, t_seen: f64) {
         let t_start = step.t0;

@@ -477,7 +477,7 @@ impl ExportModel {
         h
     }
 
-    /// The response's frequencies [Hz]: `points` log-spaced over the range (default: a
+    /// The response's frequencies \[Hz\]: `points` log-spaced over the range (default: a
     /// decade below the lowest elastic mode to 1.5 times the highest kept), with every kept
     /// resonance f_j and its half-power points f_j (1 ± ζ_j) added, sorted.
     pub fn frequency_grid(&self, range_hz: Option<(f64, f64)>, points: usize) -> Vec<f64> {

@@ -13,7 +13,7 @@ use crate::structure::{ComponentId, Structure};
 /// Where a named point sits.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PointLocation {
-    /// A point of the rigid hub, structure frame [m] (the origin is the hub's reference
+    /// A point of the rigid hub, structure frame \[m\] (the origin is the hub's reference
     /// point).
     Hub {
         /// Position, m.
@@ -58,7 +58,7 @@ pub const HUB_REFERENCE: PointLocation = PointLocation::Hub {
     position: Vec3::ZERO,
 };
 
-/// Undeformed position of a point, structure frame [m].
+/// Undeformed position of a point, structure frame \[m\].
 pub fn point_position(structure: &Structure, loc: &PointLocation) -> Vec3 {
     match *loc {
         PointLocation::Hub { position } => position,

@@ -387,7 +387,7 @@ fn csv_header(c: &Coupled) -> String {
     h
 }
 
-/// deployment.csv: one row per sample, the columns of [`csv_header`] (the text `write_deploy`
+/// deployment.csv: one row per sample, the columns of `csv_header` (the text `write_deploy`
 /// writes; the Python binding reads its columns from it).
 pub fn deployment_csv(c: &Coupled, r: &DeploymentResult) -> String {
     let mut out = csv_header(c);

@@ -38,7 +38,7 @@
 //!
 //! ## `nodes_<name>.txt` (`Source/42init.c`, `InitNodes`; sample `InOut/Nodes_Simple.txt`)
 //! A title line, a description line, the number of nodes, a header line, then per node
-//! `x y z "comment"` (position in B [m], read as `%lf %lf %lf "%[^"]"`; the comment is the
+//! `x y z "comment"` (position in B \[m\], read as `%lf %lf %lf "%[^"]"`; the comment is the
 //! node's name, 1 to 79 bytes, no double quote).
 //!
 //! ## The modal integrals (`Docs/Kane_NBody_Flex.pdf`, slides 13 and 15–17; their use in
@@ -108,9 +108,9 @@ pub struct FlexMode {
 /// A rigid mass element of the discretised structure.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MassPoint {
-    /// Position r of its centre of mass in B [m].
+    /// Position r of its centre of mass in B \[m\].
     pub position_m: Vec3,
-    /// Mass m [kg] (≥ 0).
+    /// Mass m \[kg\] (≥ 0).
     pub mass_kg: f64,
     /// Inertia about its own centre of mass, in B [kg m²] (zero for a quadrature point).
     pub inertia_kg_m2: Mat3,
@@ -136,7 +136,7 @@ pub struct FlexJoint {
 pub struct FlexNode {
     /// Name, written as the node's comment (1 to 79 bytes, no double quote or line break).
     pub name: String,
-    /// Position in B [m].
+    /// Position in B \[m\].
     pub position_m: Vec3,
     /// Per mode, the translation Ψ_p at the node [m/√kg].
     pub psi: Vec<Vec3>,
@@ -165,7 +165,7 @@ pub struct FlexBody {
 /// (module documentation), and its rigid mass properties.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModalIntegrals {
-    /// Total mass m [kg] of the mass points.
+    /// Total mass m \[kg\] of the mass points.
     pub mass_kg: f64,
     /// First mass moment c = ∫ r dm [kg m].
     pub first_moment_kg_m: Vec3,
@@ -177,24 +177,24 @@ pub struct ModalIntegrals {
     pub pf: Vec<Vec3>,
     /// Hf_p = ∫ r × Ψ_p dm (+ rotary terms), per mode [√kg m].
     pub hf: Vec<Vec3>,
-    /// L_p[i][j] = L_ijp = ∫ Ψ_ip r_j dm (+ rotary terms), per mode p [√kg m].
+    /// `L_p[i][j]` = L_ijp = ∫ Ψ_ip r_j dm (+ rotary terms), per mode p [√kg m].
     pub l: Vec<Mat3>,
-    /// N_pq[i][j] = N_ijpq = ∫ Ψ_ip Ψ_jq dm (+ rotary terms), `n[p][q]` [dimensionless].
+    /// `N_pq[i][j]` = N_ijpq = ∫ Ψ_ip Ψ_jq dm (+ rotary terms), `n[p][q]` \[dimensionless\].
     pub n: Vec<Vec<Mat3>>,
 }
 
 impl ModalIntegrals {
-    /// 42's L[i][j][p].
+    /// 42's `L[i][j][p]`.
     pub fn l_ijp(&self, i: usize, j: usize, p: usize) -> f64 {
         self.l[p][i][j]
     }
 
-    /// 42's N[i][j][p][q].
+    /// 42's `N[i][j][p][q]`.
     pub fn n_ijpq(&self, i: usize, j: usize, p: usize, q: usize) -> f64 {
         self.n[p][q][i][j]
     }
 
-    /// The mass centre c/m [m] (the origin for a massless body).
+    /// The mass centre c/m \[m\] (the origin for a massless body).
     pub fn mass_centre_m(&self) -> Vec3 {
         if self.mass_kg > 0.0 {
             self.first_moment_kg_m.map(|c| c / self.mass_kg)
@@ -312,7 +312,7 @@ pub struct ParsedFlex {
 /// A node as 42's `InitNodes` reads it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParsedNode {
-    /// Position in B [m].
+    /// Position in B \[m\].
     pub position_m: Vec3,
     /// The quoted comment (the node's name).
     pub comment: String,

@@ -12,18 +12,18 @@
 //!   removed;
 //! * the mass and stiffness matrices of a smaller set of functions are a sub-block of those of
 //!   a larger set: the model is assembled once at a *ceiling* and each refinement level is an
-//!   index selection ([`Ceiling`]), re-assembled only when a family outgrows the ceiling.
+//!   index selection (`Ceiling`), re-assembled only when a family outgrows the ceiling.
 //!
 //! **Error model.** The error of ω_k is the sum of the families' truncation errors,
 //! e_k = Σ_F e_F,k(n_F), each algebraic in the count, e_F,k(n) ≈ C n^(−p) (the corner
 //! singularities of plates and the joints bound the rate; smooth components converge faster,
 //! and an algebraic model then over-estimates: the estimate stays on the safe side). An
-//! automatic family's error is measured *forward* ([`ahead_of`]): one solve with the family
+//! automatic family's error is measured *forward* (`ahead_of`): one solve with the family
 //! one refinement up, n → n′ = b n, changes ω_k by D, and e = D b^p / (b^p − 1), the rate
 //! fitted from the step before ([`fitted_rate`], clamped to [`RATE_MIN`, `RATE_MAX`]).
-//! A plate's two directions are also refined together ([`Joint`]): the tensor-product
+//! A plate's two directions are also refined together (`Joint`): the tensor-product
 //! functions new in both directions carry error neither single step sees. Families with
-//! given terms, and automatic ones that cannot grow, are measured *backward* ([`remaining`]):
+//! given terms, and automatic ones that cannot grow, are measured *backward* (`remaining`):
 //! from the last two refinements n₀ → n₁ → n₂ with changes d₁, d₂, e = d₂ / (b^p − 1) times
 //! [`SAFETY`]. Because the frequencies converge from above, the estimate is one-sided: the
 //! true ω_k lies in [ω_k − e_k, ω_k].
@@ -34,7 +34,7 @@
 //! directions together when both matter — until the sum of the estimates is below the
 //! tolerance for every wanted mode, or no family can grow without passing `max_dof`. A
 //! refined level's frequencies are those of the forward solve that measured it, and every
-//! solve starts from the current level's eigenvectors ([`Vectors`]).
+//! solve starts from the current level's eigenvectors (`Vectors`).
 
 use super::assembly::{assemble_into, Element, ElementKind, FieldKind, HUB_DOF};
 use super::eigen::{lowest_of, Lowest, Operator};
@@ -55,7 +55,7 @@ pub const RATE_MAX: f64 = 3.0;
 /// coarsest levels (tolerance 1e-3, ~200 coordinates) still under-estimated some modes by up
 /// to 2×, before the rates settle; 1.25 keeps those within a factor 1.6.
 pub const SAFETY: f64 = 1.25;
-/// Factor on a forward estimate ([`ahead_of`]), whose rate enters far less.
+/// Factor on a forward estimate (`ahead_of`), whose rate enters far less.
 pub const FORWARD_SAFETY: f64 = 1.0;
 /// Factor on a plate's single-direction estimates when its joint step cannot be measured.
 pub const CORNER: f64 = 2.0;

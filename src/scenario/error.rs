@@ -83,7 +83,7 @@ pub fn truncate(s: &str, max: usize) -> String {
 
 impl std::fmt::Display for ScenarioError {
     /// `file:line:column: key: reason`, or `file: reason` when the file could not be read;
-    /// keys and reasons are cut to one screen ([`MAX_KEY_CHARS`], [`MAX_REASON_CHARS`]).
+    /// keys and reasons are cut to one screen (`MAX_KEY_CHARS`, `MAX_REASON_CHARS`).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let reason = truncate(&self.reason, MAX_REASON_CHARS);
         if self.kind == ErrorKind::Io {
