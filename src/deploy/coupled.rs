@@ -382,16 +382,20 @@ impl Coupled {
         // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B here, Bᵀ M₁₂, M₂₁ B and M₂₂ below
         // when dense (loops: the blocks are small, and a general product's set-up costs more
         // than the arithmetic).
-        let mb = &mut ws.mb; // M₁₁ B, row-major 6 × nb
-        refill(mb, 6 * nb, 0.0);
-        for i in 0..6 {
-            for j in 0..nb {
-                mb[i * nb + j] = (0..6).map(|k| m11[i][k] * b[k * nb + j]).sum::<f64>();
-            }
-        }
-        for i in 0..nb {
-            for j in 0..nb {
-                mbb[i * nb + j] += (0..6).map(|k| b[k * nb + i] * mb[k * nb + j]).sum::<f64>();
+        // The columns of B and of M₁₁ B as 6-arrays: each entry below is the same sum, in the
+        // same order, as over the row-major blocks, without their strided reads.
+        let (bt, mbt) = (&mut ws.bt, &mut ws.mbt);
+        bt.clear();
+        bt.extend((0..nb).map(|j| std::array::from_fn(|k| b[k * nb + j])));
+        mbt.clear();
+        mbt.extend(
+            bt.iter()
+                .map(|bj| std::array::from_fn(|i| (0..6).map(|k| m11[i][k] * bj[k]).sum::<f64>())),
+        );
+        // (No base speeds, nb = 0: a held hub on a rigid base.)
+        for (row, bi) in mbb.chunks_exact_mut(nb.max(1)).zip(bt.iter()) {
+            for (x, mj) in row.iter_mut().zip(mbt.iter()) {
+                *x += (0..6).map(|k| bi[k] * mj[k]).sum::<f64>();
             }
         }
         // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ
@@ -405,8 +409,8 @@ impl Coupled {
         for (c, col) in m12.iter().enumerate() {
             cb[6 + c] += col[0] * a_bias[0] + col[1] * a_bias[1] + col[2] * a_bias[5];
         }
-        for j in 0..nb {
-            bias[j] += (0..6).map(|i| b[i * nb + j] * cb[i]).sum::<f64>();
+        for (x, bj) in bias.iter_mut().zip(bt.iter()) {
+            *x += (0..6).map(|i| bj[i] * cb[i]).sum::<f64>();
         }
         for c in 0..n {
             bias[nb + c] += cb[6 + c];
@@ -1239,8 +1243,9 @@ struct Workspace {
     mbb: Vec<f64>,
     bias: Vec<f64>,
     force: Vec<f64>,
-    /// M₁₁ B (6 × nb) and b_c + M_c [a_b; 0].
-    mb: Vec<f64>,
+    /// The columns of B and of M₁₁ B (nb of each), and b_c + M_c [a_b; 0].
+    bt: Vec<[f64; 6]>,
+    mbt: Vec<[f64; 6]>,
     cb: Vec<f64>,
 }
 
