@@ -257,6 +257,25 @@ fn modified_magnus(
     (apply(&e[0], &apply(&expm(&omega), z)), Some(second))
 }
 
+/// One Richardson step: from a step h and two steps h/2, the extrapolation
+/// (4 y_{h/2,h/2} − y_h)/3, the estimate (y_{h/2,h/2} − y_h)/3 of the halves' error, and the
+/// halves' value.
+fn richardson(p: &Problem, kind: Method, y: &[f64], h: f64) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let whole = step(p, kind, y, h).0;
+    let half = step(p, kind, &step(p, kind, y, h / 2.0).0, h / 2.0).0;
+    let estimate = half
+        .iter()
+        .zip(&whole)
+        .map(|(a, b)| (a - b) / 3.0)
+        .collect();
+    let extrapolated = half
+        .iter()
+        .zip(&whole)
+        .map(|(a, b)| (4.0 * a - b) / 3.0)
+        .collect();
+    (extrapolated, estimate, half)
+}
+
 fn rk4(p: &Problem, y: &mut [f64], h: f64, steps: usize) {
     let n = y.len();
     for _ in 0..steps {
@@ -314,7 +333,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut scale = vec![1.0; dim];
     let e0 = c.alpha_offset() - c.modes();
     scale[e0..e0 + c.modes()].copy_from_slice(&c.base.omega[..c.modes()]);
-    let (kind, smooth, richardson) = match method {
+    let (kind, smooth, extrapolate) = match method {
         "cf4" => (Method::Cf4, false, false),
         "cf4-smooth" => (Method::Cf4, true, false),
         "mm" => (Method::Mm, false, false),
@@ -391,29 +410,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         while t < t_end - 1e-12 {
             let hh = h.min(t_end - t);
             // (the new state, its error estimate, the estimated state, whose size scales it)
-            let (next, estimate, sized): (Vec<f64>, Vec<f64>, Vec<f64>) =
-                match step(&p, kind, &y, hh) {
-                    // Mm4: the embedded second-order step; the fourth-order one goes on.
-                    (high, Some(low)) => {
-                        let d = high.iter().zip(&low).map(|(a, b)| a - b).collect();
-                        (high.clone(), d, high)
-                    }
-                    // Richardson: (y_{h/2,h/2} − y_h)/3, and the extrapolation goes on.
-                    (whole, None) => {
-                        let half = step(&p, kind, &step(&p, kind, &y, hh / 2.0).0, hh / 2.0).0;
-                        let d = half
-                            .iter()
-                            .zip(&whole)
-                            .map(|(a, b)| (a - b) / 3.0)
-                            .collect();
-                        let x = half
-                            .iter()
-                            .zip(&whole)
-                            .map(|(a, b)| (4.0 * a - b) / 3.0)
-                            .collect();
-                        (x, d, half)
-                    }
-                };
+            let (next, estimate, sized) = match kind {
+                // Mm4: the embedded second-order step; the fourth-order one goes on.
+                Method::Mm4 => {
+                    let (high, low) = step(&p, kind, &y, hh);
+                    let low = low.expect("mm4 returns its embedded step");
+                    let d = high.iter().zip(&low).map(|(a, b)| a - b).collect();
+                    (high.clone(), d, high)
+                }
+                // The Richardson pair; the extrapolation goes on.
+                _ => richardson(&p, kind, &y, hh),
+            };
             let err = ((0..dim)
                 .map(|i| {
                     let sc =
@@ -451,13 +458,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let mut y = c.initial_state();
         for _ in 0..steps {
-            y = if richardson {
-                let whole = step(&p, kind, &y, h).0;
-                let half = step(&p, kind, &step(&p, kind, &y, h / 2.0).0, h / 2.0).0;
-                half.iter()
-                    .zip(&whole)
-                    .map(|(a, b)| (4.0 * a - b) / 3.0)
-                    .collect()
+            y = if extrapolate {
+                richardson(&p, kind, &y, h).0
             } else {
                 step(&p, kind, &y, h).0
             };
