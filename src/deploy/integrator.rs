@@ -28,7 +28,7 @@ pub trait OdeSystem {
     /// Writes an approximation of ∂f/∂y at (t, y) into `jac` (n × n, zeroed by the caller)
     /// and returns true, or returns false when the system has none (an implicit stepper then
     /// differences f). What "approximation" may leave out is the stepper's business: see
-    /// [`super::rosenbrock`].
+    /// [`Rodas5P`](super::Rodas5P).
     fn jacobian(&self, _t: f64, _y: &[f64], _jac: &mut faer::Mat<f64>) -> bool {
         false
     }

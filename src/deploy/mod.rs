@@ -26,6 +26,8 @@ use crate::warning::Warning;
 use base::{BaseKind, BaseModel};
 use chain::{Chain, PlanarHub, P2};
 use coupled::{Coupled, Synchronisation};
+pub use integrator::{DenseStep, OdeSystem};
+pub use rosenbrock::Rodas5P;
 pub use swing::SwingBack;
 
 /// Why a coupled deployment could not be built.

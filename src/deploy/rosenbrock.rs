@@ -164,7 +164,7 @@ const B: [f64; STAGES] = [
     1.0,
 ];
 
-/// Adaptive Rodas5P stepper. Error control as [`super::integrator::Dopri5`]'s:
+/// Adaptive Rodas5P stepper. Error control as `Dopri5`'s:
 /// ‖err_i / (atol + rtol·max(|y0_i|, |y1_i|))‖_rms ≤ 1.
 #[derive(Debug, Clone)]
 pub struct Rodas5P {
