@@ -194,8 +194,8 @@ impl Ringing {
         let mut d = vec![0.0; n];
         for j in 0..self.c.len() {
             let a = self.c[j] * self.theta[j].exp();
-            for i in 0..n {
-                d[i] += (a * self.fast.v[j][i]).re;
+            for (di, vi) in d.iter_mut().zip(&self.fast.v[j]) {
+                *di += (a * vi).re;
             }
         }
         d
