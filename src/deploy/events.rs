@@ -33,7 +33,7 @@ pub fn earliest_latch(
     let mut event: Option<Crossing> = None;
     for (j, (&latch, _)) in latch.iter().zip(free).enumerate().filter(|(_, (_, f))| **f) {
         let g = |tt: f64| step.component(offset + j, tt) - latch;
-        if step.start()[offset + j] - latch >= 0.0 {
+        if g(t_start) >= 0.0 {
             return Some(Crossing {
                 t: t_start,
                 hinge: j,

@@ -21,6 +21,9 @@
 //! hinge dampers make the chain stiff: an implicit method (diffsol's BDF or SDIRK) is then
 //! the better choice.
 
+use super::adiabatic::RingingStep;
+use std::sync::Arc;
+
 /// One right-hand side y' = f(t, y).
 pub trait OdeSystem {
     /// Writes f(t, y) into `dy`.
@@ -79,12 +82,24 @@ pub struct DenseStep {
     /// Step length.
     pub h: f64,
     r: [Vec<f64>; 5],
+    /// The ringing the adiabatic stepper carries beside the polynomial.
+    ringing: Option<Arc<RingingStep>>,
 }
 
 impl DenseStep {
     /// The extension y(s) = r0 + s (r1 + (1 − s)(r2 + s (r3 + (1 − s) r4))), s = (t − t0)/h.
     pub(crate) fn from_coefficients(t0: f64, h: f64, r: [Vec<f64>; 5]) -> Self {
-        Self { t0, h, r }
+        Self {
+            t0,
+            h,
+            r,
+            ringing: None,
+        }
+    }
+
+    /// Adds the adiabatic stepper's ringing over this step to the extension.
+    pub(crate) fn add_ringing(&mut self, ringing: Arc<RingingStep>) {
+        self.ringing = Some(ringing);
     }
 
     /// End of the step.
@@ -100,19 +115,21 @@ impl DenseStep {
             *o = self.r[0][i]
                 + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])));
         }
-    }
-
-    /// y at the step's start.
-    pub fn start(&self) -> &[f64] {
-        &self.r[0]
+        if let Some(r) = &self.ringing {
+            r.add_to(t, out);
+        }
     }
 
     /// Component i of y(t).
     pub fn component(&self, i: usize, t: f64) -> f64 {
         let s = (t - self.t0) / self.h;
         let s1 = 1.0 - s;
-        self.r[0][i]
-            + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])))
+        let p = self.r[0][i]
+            + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])));
+        match &self.ringing {
+            Some(r) => p + r.component(i, t),
+            None => p,
+        }
     }
 }
 
@@ -280,6 +297,7 @@ impl Dopri5 {
                     t0: *t,
                     h,
                     r: [y.to_vec(), ydiff, bspl, r4, r5],
+                    ringing: None,
                 };
                 *t = if last { t_end } else { *t + h };
                 y.copy_from_slice(&y1);

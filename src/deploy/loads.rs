@@ -276,6 +276,13 @@ impl Engine for Coupled {
     fn compliant(&self) -> bool {
         self.latch.is_some()
     }
+    fn fast_threshold(&self) -> f64 {
+        let lowest = self.base.omega[..self.modes()]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        super::adiabatic::fast_threshold(lowest)
+    }
     fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
         self.rhs_captured(y, free, captured, dy);
     }

@@ -4,6 +4,7 @@
 //! structure ([`planar`]), and the run with latch events,
 //! samples, its status and warnings ([`simulate`]).
 
+pub mod adiabatic;
 pub(crate) mod articulated;
 pub mod attitude;
 pub mod base;
@@ -91,6 +92,10 @@ pub enum Integrator {
     /// Rodas5P, L-stable Rosenbrock of order 5: steps set by the resolved motion whatever the
     /// highest mode (unresolved modes are damped numerically); a Jacobian per step.
     Implicit,
+    /// The slow motion by Rodas5P on its slow manifold, the base's ringing carried along it
+    /// mode by mode ([`adiabatic`]): steps set by the deployment, not by the base modes,
+    /// which are kept (not damped).
+    Adiabatic,
 }
 
 /// How a hinge latches.

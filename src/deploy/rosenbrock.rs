@@ -169,6 +169,26 @@ const B: [f64; STAGES] = [
     1.0,
 ];
 
+/// ∂f/∂y at (t, y) by forward differences (n evaluations), f0 = f(t, y): column c from the
+/// step JAC_DELTA·max(|y_c|, 1), as represented.
+pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64]) -> Mat<f64> {
+    let n = y.len();
+    let mut j = Mat::zeros(n, n);
+    let mut yp = y.to_vec();
+    let mut fp = vec![0.0; n];
+    for c in 0..n {
+        let d = JAC_DELTA * y[c].abs().max(1.0);
+        yp[c] = y[c] + d;
+        let d = yp[c] - y[c]; // the representable step
+        sys.rhs(t, &yp, &mut fp);
+        for r in 0..n {
+            j[(r, c)] = (fp[r] - f0[r]) / d;
+        }
+        yp[c] = y[c];
+    }
+    j
+}
+
 /// Adaptive Rodas5P stepper. Error control as `Dopri5`'s:
 /// ‖err_i / (atol + rtol·max(|y0_i|, |y1_i|))‖_rms ≤ 1.
 #[derive(Debug, Clone)]
@@ -210,22 +230,8 @@ impl Rodas5P {
 
     /// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y).
     fn jacobian(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> Mat<f64> {
-        let n = y.len();
-        let mut j = Mat::zeros(n, n);
-        let mut yp = y.to_vec();
-        let mut fp = vec![0.0; n];
-        for c in 0..n {
-            let d = JAC_DELTA * y[c].abs().max(1.0);
-            yp[c] = y[c] + d;
-            let d = yp[c] - y[c]; // the representable step
-            sys.rhs(t, &yp, &mut fp);
-            for r in 0..n {
-                j[(r, c)] = (fp[r] - self.f0[r]) / d;
-            }
-            yp[c] = y[c];
-        }
-        self.evaluations += n;
-        j
+        self.evaluations += y.len();
+        forward_jacobian(sys, t, y, &self.f0)
     }
 
     /// The starting step: as DOPRI5's (Hairer's HINIT) but without its trial evaluation:

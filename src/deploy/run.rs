@@ -4,6 +4,7 @@
 //! planar chain ([`PlanarEngine`], the rigid reference) or the coupled model
 //! ([`super::coupled::Coupled`]).
 
+use super::adiabatic::Adiabatic;
 use super::chain::{Chain, Hinge, PlanarHub, P2};
 use super::events::{self, Crossing};
 use super::integrator::{DenseStep, Dopri5, OdeSystem};
@@ -46,6 +47,12 @@ pub(crate) trait Engine {
     /// The hinges latch compliantly (captured, no impact).
     fn compliant(&self) -> bool {
         false
+    }
+    /// For the adiabatic integrator: |Im λ| of ∂f/∂y above which an eigenvalue is the
+    /// base's vibration, rad/s ([`super::adiabatic::fast_threshold`]); infinite (no ringing)
+    /// by default.
+    fn fast_threshold(&self) -> f64 {
+        f64::INFINITY
     }
     /// dy/dt; `captured` flags the hinges whose compliant latch acts.
     fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]);
@@ -168,32 +175,39 @@ impl Engine for PlanarEngine<'_> {
 enum Stepper {
     Explicit(Dopri5),
     Implicit(Rodas5P),
+    Adiabatic(Box<Adiabatic>),
 }
 
 impl Stepper {
-    fn new(s: &RunSettings) -> Self {
+    fn new(s: &RunSettings, fast_threshold: f64) -> Self {
         let (rtol, atol) = (s.tolerance, s.tolerance * 1e-2);
         match s.integrator {
             Integrator::Explicit => Self::Explicit(Dopri5::new(rtol, atol, f64::INFINITY)),
             Integrator::Implicit => Self::Implicit(Rodas5P::new(rtol, atol, f64::INFINITY)),
+            Integrator::Adiabatic => {
+                Self::Adiabatic(Box::new(Adiabatic::new(rtol, atol, fast_threshold)))
+            }
         }
     }
     fn step(&mut self, sys: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_end: f64) -> DenseStep {
         match self {
             Self::Explicit(s) => s.step(sys, t, y, t_end),
             Self::Implicit(s) => s.step(sys, t, y, t_end),
+            Self::Adiabatic(s) => s.step(sys, t, y, t_end),
         }
     }
     fn restart(&mut self) {
         match self {
             Self::Explicit(s) => s.restart(),
             Self::Implicit(s) => s.restart(),
+            Self::Adiabatic(s) => s.restart(),
         }
     }
     fn evaluations(&self) -> usize {
         match self {
             Self::Explicit(s) => s.evaluations,
             Self::Implicit(s) => s.evaluations,
+            Self::Adiabatic(s) => s.evaluations(),
         }
     }
 }
@@ -259,7 +273,7 @@ impl<'a, E: Engine> Run<'a, E> {
             s,
             sys,
             latch_angles: hinges.iter().map(|j| j.latch_angle).collect(),
-            solver: Stepper::new(s),
+            solver: Stepper::new(s, engine.fast_threshold()),
             t: 0.0,
             y,
             samples,

@@ -108,6 +108,7 @@ pub(super) fn lower(
         latch,
         integrator: match d.integrator.as_ref().map(|i| *i.get_ref()) {
             Some(RawIntegrator::Implicit) => Integrator::Implicit,
+            Some(RawIntegrator::Adiabatic) => Integrator::Adiabatic,
             _ => Integrator::Explicit,
         },
         base: base(cx, raw)?,

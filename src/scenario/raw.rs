@@ -238,6 +238,7 @@ pub enum RawPerHinge {
 #[serde(rename_all = "lowercase")]
 pub enum RawIntegrator {
     Implicit,
+    Adiabatic,
     Explicit,
 }
 
