@@ -5,6 +5,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod suite {
+    pub mod adiabatic;
     pub mod array_files;
     pub mod beam_functions;
     pub mod cli;

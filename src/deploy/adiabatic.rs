@@ -415,17 +415,63 @@ impl Ringing {
     }
 }
 
+/// The ringing's mean quadratic forcing on the slow motion (second-order averaging): with
+/// δ = Σ_j a_j v_j e^{iφ_j} over all fast eigenvalues (conjugate pairs), the mean of
+/// ½ D²f(y_s)[δ, δ] over the phases is ½ Σ_j |a_j|² D²f[v_j, v̄_j] — the cross terms of
+/// different modes average out — and for v = p + iq, D²f[v, v̄] = D²f[p, p] + D²f[q, q].
+/// Each pair is differenced at its own amplitude: |a|² D²f[p, p] ≈ f(y + |a|p) − 2f(y) +
+/// f(y − |a|p), which also keeps the even terms of higher order. Small when the ringing is
+/// (the seed's release: ~1e-12 of f); after an impact the ringing is hundreds of times
+/// larger, and left out, this term moves the next latch by ~1e-6 relative.
+fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>, usize) {
+    let n = ys.len();
+    let mut f0 = vec![0.0; n];
+    sys.rhs(0.0, ys, &mut f0);
+    let (mut out, mut fp, mut y) = (vec![0.0; n], vec![0.0; n], ys.to_vec());
+    let mut evaluations = 1;
+    for (a, (v, l)) in ringing
+        .a
+        .iter()
+        .zip(ringing.modes.v.iter().zip(&ringing.modes.lam))
+    {
+        if l.im <= 0.0 {
+            continue;
+        }
+        let amp = a.norm();
+        for part in [0, 1] {
+            for sign in [1.0, -1.0] {
+                for ((yi, si), vi) in y.iter_mut().zip(ys).zip(v) {
+                    *yi = si + sign * amp * if part == 0 { vi.re } else { vi.im };
+                }
+                sys.rhs(0.0, &y, &mut fp);
+                evaluations += 1;
+                for ((o, p), q) in out.iter_mut().zip(&fp).zip(&f0) {
+                    *o += p - q;
+                }
+            }
+        }
+    }
+    (out, evaluations)
+}
+
 /// The system for Rodas5P: the full Jacobian (module docs), taken from `cached` when the step
 /// starts where the last one ended (the adiabatic step differences it there anyway), else by
 /// Rodas5P's own differences.
 struct FullJacobian<'a> {
     sys: &'a dyn OdeSystem,
     cached: Option<&'a (Vec<f64>, Mat<f64>)>,
+    /// The ringing's mean forcing, held over the step ([`mean_forcing`]).
+    forcing: Option<&'a [f64]>,
 }
 
 impl OdeSystem for FullJacobian<'_> {
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         self.sys.rhs(t, y, dy);
+        if let Some(f) = self.forcing {
+            for (d, g) in dy.iter_mut().zip(f) {
+                *d += g;
+            }
+        }
     }
     fn jacobian(&self, _t: f64, y: &[f64], jac: &mut Mat<f64>) -> bool {
         match self.cached {
@@ -449,6 +495,8 @@ pub struct Adiabatic {
     fresh: bool,
     /// J at the end of the last step, where the next one starts: (y_s, J).
     jacobian: Option<(Vec<f64>, Mat<f64>)>,
+    /// The ringing's mean forcing over the current step, when it is not negligible.
+    forcing: Option<Vec<f64>>,
     /// Right-hand-side evaluations of the decompositions and projections (Rodas5P counts
     /// its own).
     extra_evaluations: usize,
@@ -465,6 +513,7 @@ impl Adiabatic {
             ringing: None,
             fresh: true,
             jacobian: None,
+            forcing: None,
             extra_evaluations: 0,
         }
     }
@@ -473,6 +522,7 @@ impl Adiabatic {
     pub fn restart(&mut self) {
         self.fresh = true;
         self.jacobian = None;
+        self.forcing = None;
         self.slow.restart();
     }
 
@@ -516,11 +566,43 @@ impl Adiabatic {
         let delta: Vec<f64> = y.iter().zip(&ys).map(|(a, b)| a - b).collect();
         let a = modes.w.iter().map(|w| dot_real(w, &delta)).collect();
         self.ys = ys;
-        self.ringing = Some(Ringing {
+        let ringing = Ringing {
             modes,
             a,
             history: Vec::new(),
-        });
+        };
+        // The mean forcing is kept (and recomputed every step) unless it is negligible:
+        // below 1e-3 of the tolerance against f.
+        let (f2, count) = mean_forcing(sys, &self.ys, &ringing);
+        self.extra_evaluations += count;
+        let mut f = vec![0.0; y.len()];
+        sys.rhs(0.0, &self.ys, &mut f);
+        let size = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if size(&f2) <= 1e-3 * self.slow.rtol * size(&f) {
+            self.forcing = None;
+            self.ringing = Some(ringing);
+            return;
+        }
+        // Not negligible: the slow manifold is that of f + F₂ (else the forcing would act on
+        // the slow run as a step and ring in it). Project again with it, and take the
+        // ringing's amplitudes from there.
+        let forced = FullJacobian {
+            sys,
+            cached: None,
+            forcing: Some(&f2),
+        };
+        let ys = project(&forced, y, &ringing.modes);
+        self.extra_evaluations += 3 * PROJECTION_ITERATIONS + 1;
+        let delta: Vec<f64> = y.iter().zip(&ys).map(|(a, b)| a - b).collect();
+        let a = ringing
+            .modes
+            .w
+            .iter()
+            .map(|w| dot_real(w, &delta))
+            .collect();
+        self.ys = ys;
+        self.forcing = Some(f2);
+        self.ringing = Some(Ringing { a, ..ringing });
     }
 
     /// One accepted step from (t, y) towards at most `t_end`: y is the whole state (slow +
@@ -536,11 +618,54 @@ impl Adiabatic {
             self.split(sys, y);
         }
         let t0 = *t;
-        let full = FullJacobian {
-            sys,
-            cached: self.jacobian.as_ref(),
+        let mut dense = match (self.forcing.take(), self.ringing.as_ref()) {
+            (Some(f_start), Some(ringing)) => {
+                // Predictor with F₂ at the start, corrector with the mean of F₂ at both
+                // ends (the trapezoidal rule: second order in the forcing's drift, which
+                // a step held constant would get only to first order).
+                let (before, ys0) = (self.slow.clone(), self.ys.clone());
+                let predictor = FullJacobian {
+                    sys,
+                    cached: self.jacobian.as_ref(),
+                    forcing: Some(&f_start),
+                };
+                self.slow.refresh_derivative(&predictor, t0, &self.ys);
+                let mut t1 = t0;
+                self.slow.step(&predictor, &mut t1, &mut self.ys, t_end);
+                let proposed = self.slow.proposed_step();
+                let (f_end, count) = mean_forcing(sys, &self.ys, ringing);
+                self.extra_evaluations += count;
+                let mean: Vec<f64> = f_start
+                    .iter()
+                    .zip(&f_end)
+                    .map(|(a, b)| 0.5 * (a + b))
+                    .collect();
+                self.slow = before;
+                self.ys = ys0;
+                let corrector = FullJacobian {
+                    sys,
+                    cached: self.jacobian.as_ref(),
+                    forcing: Some(&mean),
+                };
+                self.slow.refresh_derivative(&corrector, t0, &self.ys);
+                let dense = self.slow.step(&corrector, t, &mut self.ys, t1);
+                if *t == t1 {
+                    self.slow.set_proposed_step(proposed);
+                }
+                self.forcing = Some(f_end);
+                dense
+            }
+            (forcing, _) => {
+                let full = FullJacobian {
+                    sys,
+                    cached: self.jacobian.as_ref(),
+                    forcing: forcing.as_deref(),
+                };
+                let dense = self.slow.step(&full, t, &mut self.ys, t_end);
+                self.forcing = forcing;
+                dense
+            }
         };
-        let mut dense = self.slow.step(&full, t, &mut self.ys, t_end);
         y.copy_from_slice(&self.ys);
         let n = y.len();
         let Some(count) = self.ringing.as_ref().map(|r| r.a.len()) else {
@@ -620,11 +745,14 @@ mod tests {
         assert_eq!(complex_pairs, 4);
     }
 
+    /// A second formulation: DOPRI5 at 1e-12 resolving every period. The state starts off
+    /// the slow manifold (x at rest away from its quasi-static value, v₁ = 0.05), so both
+    /// oscillators ring (x₁'s velocity amplitude 0.05) while their frequencies drift by 20 %
+    /// and 10 % over 10 s (~430 periods of the faster). At tolerance 1e-8: the state at the
+    /// end to 1e-4 of the ringing's velocity amplitude (3.9e-5 measured), in under 400 steps
+    /// (162), and the dense output continuous at every step's end.
     #[test]
     fn the_ringing_follows_drifting_frequencies_as_a_tight_explicit_run_does() {
-        // A second formulation: DOPRI5 at 1e-12 resolving every period. The state starts
-        // off the slow manifold (x at rest, away from its quasi-static value), so both
-        // oscillators ring while their frequencies drift by 20 % and 10 %.
         let y0 = [1e-3, -2e-3, 0.05, 0.0, 0.0];
         let t_end = 10.0;
         let mut reference = y0.to_vec();
@@ -635,29 +763,21 @@ mod tests {
         }
         let mut ad = Adiabatic::new(1e-8, 1e-10, 10.0);
         let (mut t, mut y, mut steps) = (0.0, y0.to_vec(), 0);
-        let mut mid_error = 0.0f64;
+        let mut jump = 0.0f64;
         while t < t_end {
             let dense = ad.step(&Drift, &mut t, &mut y, t_end);
             steps += 1;
-            // The dense output in the middle of a step against the step's own ends: it
-            // must be continuous at the end.
             let mut end = vec![0.0; 5];
             dense.eval(dense.t1(), &mut end);
             for i in 0..5 {
-                mid_error = mid_error.max((end[i] - y[i]).abs());
+                jump = jump.max((end[i] - y[i]).abs());
             }
         }
         let err: f64 = (0..4)
             .map(|i| (y[i] - reference[i]).abs())
             .fold(0.0, f64::max);
-        let ringing: f64 = 0.05 / 40.0;
-        // Stepped over: tens of steps for 10 s against ~1100 periods of the fast oscillator.
-        eprintln!("steps {steps} err {err:e} end {mid_error:e}");
-        assert!(steps < 200, "{steps} steps");
-        assert!(err < 1e-3 * ringing.max(1e-6) * 40.0, "error {err:e}");
-        assert!(
-            mid_error < 1e-12,
-            "dense output at the step end off by {mid_error:e}"
-        );
+        assert!(steps < 400, "{steps} steps");
+        assert!(err < 1e-4 * 0.05, "error {err:e}");
+        assert!(jump < 1e-12, "dense output at the step end off by {jump:e}");
     }
 }

@@ -228,6 +228,25 @@ impl Rodas5P {
         self.fresh = true;
     }
 
+    /// The step size the controller proposes next, s.
+    pub(crate) fn proposed_step(&self) -> f64 {
+        self.h
+    }
+
+    /// Overrides the step size the controller proposes next, s.
+    pub(crate) fn set_proposed_step(&mut self, h: f64) {
+        self.h = h;
+    }
+
+    /// Recompute the derivative at the current point, keeping the step size (after a change
+    /// of the right-hand side that is not an impulse).
+    pub(crate) fn refresh_derivative(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) {
+        if !self.fresh && self.f0.len() == y.len() {
+            sys.rhs(t, y, &mut self.f0);
+            self.evaluations += 1;
+        }
+    }
+
     /// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y).
     fn jacobian(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> Mat<f64> {
         self.evaluations += y.len();
