@@ -22,7 +22,8 @@
 //! Run: `cargo run --release --example slow_manifold_study -- 20 1e-8 project fd`
 //! (base modes, tolerance, `project` | `release`, `fd` | `stiff`).
 
-use faer::{c64, Mat};
+use faer::Mat;
+use flexcraft::deploy::adiabatic::{fast_threshold, slow_manifold, Adiabatic};
 use flexcraft::deploy::coupled::Coupled;
 use flexcraft::deploy::{Deployment, OdeSystem, Rodas5P};
 use flexcraft::Scenario;
@@ -48,160 +49,6 @@ impl OdeSystem for Sys<'_> {
     }
 }
 
-/// ∂f/∂y by central differences.
-fn jacobian(s: &Sys, y: &[f64]) -> Mat<f64> {
-    let n = y.len();
-    let mut j = Mat::<f64>::zeros(n, n);
-    let (mut fp, mut fm, mut yp) = (vec![0.0; n], vec![0.0; n], y.to_vec());
-    for k in 0..n {
-        let d = 1e-6 * y[k].abs().max(1e-3);
-        yp[k] = y[k] + d;
-        s.rhs(0.0, &yp, &mut fp);
-        yp[k] = y[k] - d;
-        s.rhs(0.0, &yp, &mut fm);
-        yp[k] = y[k];
-        for i in 0..n {
-            j[(i, k)] = (fp[i] - fm[i]) / (2.0 * d);
-        }
-    }
-    j
-}
-
-/// The fast eigen-triples of J(y) (|Im λ| > `fast_above`): λ_j, v_j and w_j with w_jᵀ v_j = 1.
-struct Fast {
-    lam: Vec<c64>,
-    v: Vec<Vec<c64>>,
-    w: Vec<Vec<c64>>,
-}
-
-fn fast_part(s: &Sys, y: &[f64], fast_above: f64) -> Result<Fast, Box<dyn std::error::Error>> {
-    let n = y.len();
-    let j = jacobian(s, y);
-    let right = j.eigen().map_err(|e| format!("{e:?}"))?;
-    let left = j
-        .transpose()
-        .to_owned()
-        .eigen()
-        .map_err(|e| format!("{e:?}"))?;
-    let (lam, laml) = (right.S().column_vector(), left.S().column_vector());
-    let mut fast = Fast {
-        lam: Vec::new(),
-        v: Vec::new(),
-        w: Vec::new(),
-    };
-    for a in 0..n {
-        let l = lam[a];
-        if l.im.abs() <= fast_above {
-            continue;
-        }
-        let b = (0..n)
-            .min_by(|&p, &q| (laml[p] - l).norm().total_cmp(&(laml[q] - l).norm()))
-            .ok_or("no left eigenvector")?;
-        let v: Vec<c64> = (0..n).map(|i| right.U()[(i, a)]).collect();
-        let w: Vec<c64> = (0..n).map(|i| left.U()[(i, b)]).collect();
-        let wv = dotc(&w, &v);
-        fast.lam.push(l);
-        fast.v.push(v);
-        fast.w.push(w.iter().map(|x| x / wv).collect());
-    }
-    Ok(fast)
-}
-
-/// Σ a_i b_i without conjugation.
-fn dotc(a: &[c64], b: &[c64]) -> c64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// y moved onto the slow manifold along the fast eigen-directions of J(y) (module docs).
-fn project(s: &Sys, y: &[f64], fast: &Fast) -> Vec<f64> {
-    let n = y.len();
-    let (mut ys, mut f) = (y.to_vec(), vec![0.0; n]);
-    for it in 0..4 {
-        s.rhs(0.0, &ys, &mut f);
-        let mut largest = 0.0f64;
-        for ((v, w), l) in fast.v.iter().zip(&fast.w).zip(&fast.lam) {
-            let wf: c64 = w.iter().zip(&f).map(|(a, b)| a * b).sum();
-            largest = largest.max(wf.norm());
-            let c = wf / l;
-            for i in 0..n {
-                ys[i] -= (v[i] * c).re;
-            }
-        }
-        println!("Newton {it}: largest |w_jᵀ f| before the update {largest:.3e}");
-    }
-    ys
-}
-
-/// The ringing carried adiabatically along the slow run: δ = Re Σ_j c_j e^{θ_j} v_j(t), the
-/// eigenvectors parallel-transported (w_j(t_k)ᵀ v_j(t_{k+1}) = 1), θ_j = ∫ λ_j dt by the
-/// trapezoidal rule over the slow steps.
-struct Ringing {
-    fast: Fast,
-    c: Vec<c64>,
-    theta: Vec<c64>,
-}
-
-impl Ringing {
-    fn new(fast: Fast, delta: &[f64]) -> Self {
-        let c: Vec<c64> = fast
-            .w
-            .iter()
-            .map(|w| w.iter().zip(delta).map(|(a, b)| a * b).sum())
-            .collect();
-        let theta = vec![c64::new(0.0, 0.0); c.len()];
-        Self { fast, c, theta }
-    }
-
-    /// Moves on through `mid` (at h/2) to `next` (at h): the eigenvectors transported through
-    /// both, the phases by Simpson's rule.
-    fn advance_simpson(&mut self, mid: Fast, next: Fast, h: f64) {
-        let (l0, t0) = (self.fast.lam.clone(), self.theta.clone());
-        self.advance(mid, 0.5 * h);
-        let lm = self.fast.lam.clone();
-        self.advance(next, 0.5 * h);
-        for j in 0..self.theta.len() {
-            self.theta[j] = t0[j] + (l0[j] + lm[j] * 4.0 + self.fast.lam[j]) * (h / 6.0);
-        }
-    }
-
-    /// Moves on to the decomposition `next`, a step h later.
-    fn advance(&mut self, next: Fast, h: f64) {
-        let mut taken = vec![false; next.lam.len()];
-        let mut lam = Vec::new();
-        let (mut v, mut w) = (Vec::new(), Vec::new());
-        for j in 0..self.fast.lam.len() {
-            let l = self.fast.lam[j];
-            // The new pair with the largest overlap w_j(t_k)ᵀ v_k(t_{k+1}): eigenvalues of
-            // modes that do not couple (in-plane and out-of-plane bending) cross as the
-            // configuration changes, so the nearest eigenvalue is not the same mode.
-            let overlap = |k: usize| dotc(&self.fast.w[j], &next.v[k]).norm();
-            let k = (0..next.lam.len())
-                .filter(|&k| !taken[k])
-                .max_by(|&p, &q| overlap(p).total_cmp(&overlap(q)))
-                .expect("as many fast pairs");
-            taken[k] = true;
-            let g = dotc(&self.fast.w[j], &next.v[k]);
-            self.theta[j] += (l + next.lam[k]) * (0.5 * h);
-            lam.push(next.lam[k]);
-            v.push(next.v[k].iter().map(|x| x / g).collect::<Vec<_>>());
-            w.push(next.w[k].iter().map(|x| x * g).collect::<Vec<_>>());
-        }
-        self.fast = Fast { lam, v, w };
-    }
-
-    fn delta(&self) -> Vec<f64> {
-        let n = self.fast.v[0].len();
-        let mut d = vec![0.0; n];
-        for j in 0..self.c.len() {
-            let a = self.c[j] * self.theta[j].exp();
-            for (di, vi) in d.iter_mut().zip(&self.fast.v[j]) {
-                *di += (a * vi).re;
-            }
-        }
-        d
-    }
-}
-
 /// Largest differences: α [rad], α̇ [rad/s], ω·η and η̇ [√kg·m/s].
 fn errors(c: &Coupled, y: &[f64], r: &[f64]) -> [f64; 4] {
     let (m, n, np) = (c.modes(), c.panels(), c.positions());
@@ -216,8 +63,9 @@ fn errors(c: &Coupled, y: &[f64], r: &[f64]) -> [f64; 4] {
     ]
 }
 
-/// Slow run plus adiabatic ringing to `t_end`, against the RK4 reference that
-/// `examples/magnus_study.rs` cached for (modes, t_end).
+/// The library's adiabatic stepper (`integrator = "adiabatic"`) to `t_end`, against the RK4
+/// reference that `examples/magnus_study.rs` cached for (modes, t_end); beside it the slow
+/// run alone (the state projected, no ringing).
 fn ringing_run(
     s: &Sys,
     modes: usize,
@@ -231,63 +79,36 @@ fn ringing_run(
         .lines()
         .map(|l| l.parse())
         .collect::<Result<_, _>>()?;
-    let clock = Instant::now();
-    let y0 = c.initial_state();
-    let fast = fast_part(s, &y0, 20.0)?;
-    let mut y = project(s, &y0, &fast);
-    let delta0: Vec<f64> = y0.iter().zip(&y).map(|(a, b)| a - b).collect();
-    let mut ringing = Ringing::new(fast_part(s, &y, 20.0)?, &delta0);
-    let back = ringing.delta();
-    let miss = back
-        .iter()
-        .zip(&delta0)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    println!("ringing at t = 0 rebuilt from its modes to {miss:.2e}");
-    let simpson = std::env::var("SIMPSON").is_ok();
-    let h_max = std::env::var("H_MAX").map_or(Ok(f64::INFINITY), |v| v.parse())?;
-    let mut stepper = Rodas5P::new(tol, tol * 1e-2, h_max);
-    let (mut t, mut steps) = (0.0, 0usize);
-    while t < t_end {
-        let t_before = t;
-        let dense = stepper.step(s, &mut t, &mut y, t_end);
-        steps += 1;
-        if simpson {
-            let mut ym = vec![0.0; y.len()];
-            dense.eval(0.5 * (t_before + t), &mut ym);
-            let mid = fast_part(s, &ym, 20.0)?;
-            ringing.advance_simpson(mid, fast_part(s, &y, 20.0)?, t - t_before);
-        } else {
-            ringing.advance(fast_part(s, &y, 20.0)?, t - t_before);
+    let threshold = fast_threshold(c.base.omega[0]);
+    let run = |y: &mut Vec<f64>, adiabatic: bool| {
+        let clock = Instant::now();
+        let (mut t, mut steps) = (0.0, 0usize);
+        let mut ad = Adiabatic::new(
+            tol,
+            tol * 1e-2,
+            if adiabatic { threshold } else { f64::INFINITY },
+        );
+        while t < t_end {
+            ad.step(s, &mut t, y, t_end);
+            steps += 1;
         }
-    }
-    let cpu = clock.elapsed().as_secs_f64();
-    let total: Vec<f64> = y.iter().zip(ringing.delta()).map(|(a, b)| a + b).collect();
-    let (es, et) = (errors(c, &y, &reference), errors(c, &total, &reference));
-    println!("to {t_end} s: {steps} slow steps, CPU {cpu:.2} s (the decompositions included)");
-    println!("errors against RK4 | α [rad] | α̇ [rad/s] | ω·η | η̇ [√kg·m/s]");
+        (steps, ad.evaluations(), clock.elapsed().as_secs_f64())
+    };
+    let y0 = c.initial_state();
+    let mut slow = slow_manifold(s, &y0, threshold).ok_or("eigensolver")?.0;
+    let (steps_s, ev_s, cpu_s) = run(&mut slow, false);
+    let mut total = y0.clone();
+    let (steps, ev, cpu) = run(&mut total, true);
+    let (es, et) = (errors(c, &slow, &reference), errors(c, &total, &reference));
+    println!("errors against RK4 to {t_end} s | steps | evaluations | CPU [s] | α [rad] | α̇ [rad/s] | ω·η | η̇ [√kg·m/s]");
     println!(
-        "slow run alone | {:.1e} | {:.1e} | {:.1e} | {:.1e}",
+        "slow run alone | {steps_s} | {ev_s} | {cpu_s:.3} | {:.1e} | {:.1e} | {:.1e} | {:.1e}",
         es[0], es[1], es[2], es[3]
     );
     println!(
-        "slow + ringing | {:.1e} | {:.1e} | {:.1e} | {:.1e}",
+        "adiabatic | {steps} | {ev} | {cpu:.3} | {:.1e} | {:.1e} | {:.1e} | {:.1e}",
         et[0], et[1], et[2], et[3]
     );
-    if std::env::var("PER_MODE").is_ok() {
-        let (e0, ed) = (c.alpha_offset() - c.modes(), c.positions() + c.hub_dof());
-        for k in 0..c.modes() {
-            let w = c.base.omega[k];
-            println!(
-                "mode {k:2} {:8.1} Hz: ringing ω·η {:.2e} error {:.2e} | η̇ {:.2e} error {:.2e}",
-                w / std::f64::consts::TAU,
-                ((reference[e0 + k] - y[e0 + k]) * w).abs(),
-                ((reference[e0 + k] - total[e0 + k]) * w).abs(),
-                (reference[ed + k] - y[ed + k]).abs(),
-                (reference[ed + k] - total[ed + k]).abs()
-            );
-        }
-    }
     Ok(())
 }
 
@@ -316,7 +137,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return ringing_run(&s, modes, t_end, tol);
     }
     let mut y = if projected {
-        project(&s, &y0, &fast_part(&s, &y0, 20.0)?)
+        slow_manifold(&s, &y0, 20.0).ok_or("eigensolver")?.0
     } else {
         y0.clone()
     };

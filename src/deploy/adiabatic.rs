@@ -11,26 +11,31 @@
 //!   impact or a capture) the state is moved onto it along the fast eigen-directions of
 //!   J = ∂f/∂y: with J's fast eigenvalues λ_j (|Im λ_j| above [`fast_threshold`]) and
 //!   right and left eigenvectors v_j, w_j (w_jᵀ v_j = 1), the Newton iteration
-//!   y_s ← y_s − Re Σ_j v_j λ_j⁻¹ w_jᵀ f(y_s) drives every fast component of f to zero
-//!   ([`project`]). Then [`Rodas5P`] integrates y_s with its error control, from the full
+//!   y_s ← y_s − Re Σ_j v_j λ_j⁻¹ (w_jᵀ f(y_s) − g_j) sets every fast component of f to the
+//!   drift g_j the slow motion gives the fast coordinates (zero at release, which starts
+//!   from rest). Then [`Rodas5P`] integrates y_s with its error control, from the full
 //!   Jacobian by differences: Rodas5P is not a W-method, and with the stiff part alone it
 //!   must resolve the fast modes again.
 //! * **δ, the ringing**, the rest: small (its energy is ~1e-8 of the deployment's on the
-//!   seed), so it obeys the linearisation δ' = J(y_s(t)) δ, whose fast eigenvalues drift
-//!   slowly with the configuration. To first order in that drift (the adiabatic theorem)
-//!   δ(t) = Re Σ_j c_j e^{θ_j(t)} v_j(t), θ_j = ∫ λ_j dt, with c_j = w_jᵀ δ(0) constant
-//!   once the eigenvectors are parallel-transported (w_j(t_k)ᵀ v_j(t_{k+1}) = 1). J is
-//!   decomposed at the start, the middle and the end of every slow step; modes are matched
-//!   across steps by the overlap w_jᵀ v_k, not by the nearest eigenvalue (the in-plane and
-//!   out-of-plane bending frequencies cross as the panels open); θ_j follows Simpson's rule,
-//!   and within a step θ_j(τ) is the integral of the quadratic through the three λ_j and
-//!   v_j(τ) the quadratic through the three eigenvectors ([`RingingStep`]).
+//!   seed after release), so it obeys the linearisation δ' = J(y_s(t)) δ, whose fast
+//!   eigenvalues drift slowly with the configuration. To first order in that drift (the
+//!   adiabatic theorem) δ(t) = Re Σ_j c_j e^{θ_j(t)} v_j(t), θ_j = ∫ λ_j dt, with
+//!   c_j = w_jᵀ δ(0) constant once the eigenvectors are parallel-transported
+//!   ((w_j(t_k) + w_j(t_{k+1}))ᵀ (v_j(t_{k+1}) − v_j(t_k)) = 0). J is differenced and
+//!   decomposed at every slow step's end (and serves the next Rodas5P step); modes are
+//!   matched across steps by the overlap w_jᵀ v_k, not by the nearest eigenvalue (the
+//!   in-plane and out-of-plane bending frequencies cross as the panels open); θ_j integrates
+//!   the cubic through λ_j at the last four step ends, and within a step v_j is linear
+//!   between its ends ([`RingingStep`]).
+//! * **The ringing's mean forcing** F₂ on the slow motion, the phase average of
+//!   ½ D²f[δ, δ] (`mean_forcing`): negligible after release, but after an impact the mast
+//!   rings hundreds of times harder, and left out it moves the next latch by ~1e-6 relative.
 //!
-//! What is left out: O(|δ|²), the ringing's feedback on the slow motion, and the
-//! non-adiabatic terms, O(ε) of the ringing with ε the slow rates over the base's lowest
-//! frequency. Measured on the seed with 20 base modes against RK4 at h = 5 µs over 20 s
-//! (`examples/slow_manifold_study.rs`): 16 slow steps, α to 4e-11 rad, ω·η to 2.4e-8 against
-//! a ringing of 5.4e-4 (DOPRI5 at the same tolerance: 6e-6).
+//! What is left out: the terms of third order in δ, and the non-adiabatic coupling, O(ε) of
+//! the ringing with ε the slow rates over the fast frequencies. Measured on the seed with 20
+//! base modes against RK4 at h = 5 µs (`examples/slow_manifold_study.rs`): to 20 s in 16
+//! slow steps, α to 1.7e-11 rad and ω·η to 3.0e-7 against a ringing of 5.4e-4; to 55 s in
+//! 90, 3.8e-9 rad and 7.7e-8 (DOPRI5 at the same tolerance: 6e-6).
 //!
 //! Hand-written because no crate offers it: it is a method for this model's structure (a
 //! slow mechanism on a linear, weakly excited elastic base), built from faer's eigensolver
@@ -290,6 +295,15 @@ fn integrate(ts: &[f64], ls: &[c64], a: f64, b: f64) -> c64 {
         .sum()
 }
 
+/// `y` moved onto the slow manifold of y' = f(y) along the fast eigen-directions of ∂f/∂y
+/// (|Im λ| > `threshold`, rad/s), to first order in the slow motion's rate (module docs), and
+/// the number of fast eigenvalues; None when the eigensolver fails.
+pub fn slow_manifold(sys: &dyn OdeSystem, y: &[f64], threshold: f64) -> Option<(Vec<f64>, usize)> {
+    let modes = fast_modes(&central_jacobian(sys, y), threshold, None)?;
+    let count = modes.lam.len();
+    Some((project(sys, y, &modes), count))
+}
+
 /// The ringing over one slow step [t0, t1]: δ(t) = Re Σ_j a_j e^{θ_j(t)} v_j(t), with
 /// θ_j(t) = ∫_{t0}^t λ_j, λ_j the polynomial through its values at this step's ends and up to
 /// two earlier ones (cubic: the phase is fourth-order accurate, as the step's slow motion),
@@ -356,7 +370,7 @@ impl Ringing {
             v: Vec::with_capacity(k_count),
             w: Vec::with_capacity(k_count),
         };
-        for w_old in &self.modes.w {
+        for (w_old, v_old) in self.modes.w.iter().zip(&self.modes.v) {
             let overlap = |k: usize| dot(w_old, &next.v[k]).norm();
             let Some(k) = (0..k_count)
                 .filter(|&k| !taken[k])
@@ -365,7 +379,17 @@ impl Ringing {
                 break;
             };
             taken[k] = true;
-            let g = dot(w_old, &next.v[k]);
+            // The symmetric (trapezoidal) transport: the scale g of v_new = ṽ/g, w_new = w̃g
+            // with (w_old + w_new)ᵀ(v_new − v_old) = 0, i.e. g² = (w_oldᵀṽ)/(w̃ᵀv_old);
+            // second order in the step, where w_oldᵀ v_new = 1 alone is first.
+            let one_sided = dot(w_old, &next.v[k]);
+            let back = dot(&next.w[k], v_old);
+            let root = (one_sided / back).sqrt();
+            let g = if (root - one_sided).norm() <= (root + one_sided).norm() {
+                root
+            } else {
+                -root
+            };
             out.lam.push(next.lam[k]);
             out.v.push(next.v[k].iter().map(|x| x / g).collect());
             out.w.push(next.w[k].iter().map(|x| x * g).collect());
@@ -460,7 +484,7 @@ fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>
 struct FullJacobian<'a> {
     sys: &'a dyn OdeSystem,
     cached: Option<&'a (Vec<f64>, Mat<f64>)>,
-    /// The ringing's mean forcing, held over the step ([`mean_forcing`]).
+    /// The ringing's mean forcing, held over the step (`mean_forcing`).
     forcing: Option<&'a [f64]>,
 }
 

@@ -63,7 +63,7 @@ fn latch_differences(a: &DeploymentResult, b: &DeploymentResult) -> [f64; 4] {
 /// The seed (ideal cable: one latch of all three hinges at 60 s) with 6 base modes, which ring
 /// from release: at tolerance 1e-8 against DOPRI5 at 1e-11, the latch time to 2e-9 relative
 /// (measured 4.2e-10: the ringing's share of the opening angles, 1.7e-8 rad at release, is in
-/// it), the rates before and after and the base impulse to 3e-7 (6.2e-8), with fewer than
+/// it), the rates before and after and the base impulse to 3e-7 (6.6e-8), with fewer than
 /// 2 % of the reference's evaluations (0.5 %).
 #[test]
 fn seed_with_the_ideal_cable_matches_the_explicit_reference_in_few_steps() {
