@@ -7,11 +7,7 @@ use flexcraft::deploy::base::BaseKind;
 use flexcraft::deploy::{simulate_coupled, Deployment, DeploymentResult, Integrator};
 use flexcraft::scenario::Scenario;
 
-fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
-    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
-    let src = edit(std::fs::read_to_string(&path).unwrap());
-    Scenario::from_toml_str(&src, &path).unwrap()
-}
+use super::common::edited_example as scenario;
 
 /// `sc`'s deployment with `modes` base modes, the integrator and tolerance given, run.
 fn run(sc: &Scenario, modes: usize, integrator: Integrator, tol: f64) -> DeploymentResult {

@@ -7,6 +7,13 @@ pub fn scenario(toml: &str) -> Scenario {
     Scenario::from_toml_str(toml, "test.toml").unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// Parses the bundled example `examples/<name>` after `edit` has changed its text.
+pub fn edited_example(name: &str, edit: impl Fn(String) -> String) -> Scenario {
+    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+    let src = edit(std::fs::read_to_string(&path).unwrap());
+    Scenario::from_toml_str(&src, &path).unwrap()
+}
+
 /// Assembles and solves a scenario.
 pub fn solve(toml: &str) -> (RitzModel, ModalAnalysis) {
     let s = scenario(toml);

@@ -7,11 +7,7 @@ use flexcraft::deploy::coupled::{Coupled, Synchronisation};
 use flexcraft::deploy::{simulate, Deployment};
 use flexcraft::scenario::Scenario;
 
-fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
-    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
-    let src = edit(std::fs::read_to_string(&path).unwrap());
-    Scenario::from_toml_str(&src, &path).unwrap()
-}
+use super::common::edited_example as scenario;
 
 /// The coupled model of a scenario's deployment (hub motion from `[hub] motion`, no cable,
 /// the given base).

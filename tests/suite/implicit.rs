@@ -8,11 +8,7 @@ use flexcraft::deploy::{simulate_coupled, Deployment, Integrator};
 use flexcraft::faer::Mat;
 use flexcraft::scenario::Scenario;
 
-fn scenario(name: &str, edit: impl Fn(String) -> String) -> Scenario {
-    let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
-    let src = edit(std::fs::read_to_string(&path).unwrap());
-    Scenario::from_toml_str(&src, &path).unwrap()
-}
+use super::common::edited_example as scenario;
 
 /// The seed's deployment (free hub, ideal cable, all three hinges latch at once) with
 /// `modes` base modes, the integrator and tolerance given.
