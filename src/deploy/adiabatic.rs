@@ -47,7 +47,7 @@ use faer::{c64, Mat};
 use std::sync::Arc;
 
 /// Central-difference step for the decomposed Jacobian, relative to max(|y_i|, 1e-3).
-const JAC_DELTA: f64 = 1e-6;
+const CENTRAL_DELTA: f64 = 1e-6;
 
 /// Newton iterations of the projection onto the slow manifold (two suffice on the seed:
 /// 4e-2 → 2e-9 → 7e-17).
@@ -81,7 +81,7 @@ fn central_jacobian(sys: &dyn OdeSystem, y: &[f64]) -> Mat<f64> {
     let mut j = Mat::<f64>::zeros(n, n);
     let (mut fp, mut fm, mut yp) = (vec![0.0; n], vec![0.0; n], y.to_vec());
     for k in 0..n {
-        let d = JAC_DELTA * y[k].abs().max(1e-3);
+        let d = CENTRAL_DELTA * y[k].abs().max(1e-3);
         yp[k] = y[k] + d;
         sys.rhs(0.0, &yp, &mut fp);
         yp[k] = y[k] - d;
@@ -260,6 +260,10 @@ fn project(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes) -> Vec<f64> {
     newton(sys, &y0, modes, &rates)
 }
 
+/// The least |w_oldᵀ v_new| |w_newᵀ v_old| (1 for an unchanged mode) at which a mode is
+/// matched across a step.
+const MIN_OVERLAP: f64 = 0.5;
+
 /// Up to four past step ends (time and every mode's λ), the phase's interpolation nodes.
 const PHASE_NODES: usize = 4;
 
@@ -361,9 +365,15 @@ struct Ringing {
 }
 
 impl Ringing {
-    /// The modes of `next` matched to the current ones by overlap and parallel-transported.
-    fn transport(&self, next: FastModes) -> FastModes {
+    /// The modes of `next` matched to the current ones by overlap and parallel-transported;
+    /// None when a mode has no clear partner (overlap |w_oldᵀ v_new| |w_newᵀ v_old| below
+    /// [`MIN_OVERLAP`]: the modes changed too much over the step, or one crossed the
+    /// threshold).
+    fn transport(&self, next: &FastModes) -> Option<FastModes> {
         let k_count = next.lam.len();
+        if k_count != self.a.len() {
+            return None;
+        }
         let mut taken = vec![false; k_count];
         let mut out = FastModes {
             lam: Vec::with_capacity(k_count),
@@ -371,35 +381,41 @@ impl Ringing {
             w: Vec::with_capacity(k_count),
         };
         for (w_old, v_old) in self.modes.w.iter().zip(&self.modes.v) {
-            let overlap = |k: usize| dot(w_old, &next.v[k]).norm();
-            let Some(k) = (0..k_count)
+            // |w_oldᵀ v_k| |w_kᵀ v_old|: 1 for an unchanged mode, and independent of how the
+            // eigensolver splits the scale between v_k and w_k (only w_kᵀ v_k = 1 is fixed).
+            let overlap = |k: usize| (dot(w_old, &next.v[k]) * dot(&next.w[k], v_old)).norm();
+            let k = (0..k_count)
                 .filter(|&k| !taken[k])
-                .max_by(|&p, &q| overlap(p).total_cmp(&overlap(q)))
-            else {
-                break;
-            };
+                .max_by(|&p, &q| overlap(p).total_cmp(&overlap(q)))?;
             taken[k] = true;
             // The symmetric (trapezoidal) transport: the scale g of v_new = ṽ/g, w_new = w̃g
             // with (w_old + w_new)ᵀ(v_new − v_old) = 0, i.e. g² = (w_oldᵀṽ)/(w̃ᵀv_old);
             // second order in the step, where w_oldᵀ v_new = 1 alone is first.
             let one_sided = dot(w_old, &next.v[k]);
             let back = dot(&next.w[k], v_old);
+            if (one_sided * back).norm() < MIN_OVERLAP {
+                return None;
+            }
             let root = (one_sided / back).sqrt();
             let g = if (root - one_sided).norm() <= (root + one_sided).norm() {
                 root
             } else {
                 -root
             };
+            if !(g.re.is_finite() && g.im.is_finite()) {
+                return None;
+            }
             out.lam.push(next.lam[k]);
             out.v.push(next.v[k].iter().map(|x| x / g).collect());
             out.w.push(next.w[k].iter().map(|x| x * g).collect());
         }
-        out
+        Some(out)
     }
 
-    /// Moves on from t0 to t1, where the modes are `end`. Returns the step's ringing.
-    fn advance(&mut self, t0: f64, t1: f64, end: FastModes) -> RingingStep {
-        let end = self.transport(end);
+    /// Moves on from t0 to t1, where the modes are `end`; returns the step's ringing, or None
+    /// (nothing changed) when the modes cannot be matched.
+    fn advance(&mut self, t0: f64, t1: f64, end: &FastModes) -> Option<RingingStep> {
+        let end = self.transport(end)?;
         let start = std::mem::replace(&mut self.modes, end);
         if self.history.is_empty() {
             self.history.push((t0, start.lam.clone()));
@@ -423,6 +439,29 @@ impl Ringing {
             self.a[j] *= integrate(&nodes, &lam, t0, t1).exp();
             step.lam.push(lam);
             step.v.push([start.v[j].clone(), self.modes.v[j].clone()]);
+        }
+        Some(step)
+    }
+
+    /// The step's ringing with the modes held at the step's start (first order): the
+    /// fallback when the end's modes cannot be had, before the state is split afresh.
+    fn advance_frozen(&mut self, t0: f64, t1: f64) -> RingingStep {
+        let lam: Vec<Vec<c64>> = self.modes.lam.iter().map(|&l| vec![l, l]).collect();
+        let step = RingingStep {
+            t0,
+            t1,
+            a: self.a.clone(),
+            nodes: vec![t0, t1],
+            lam,
+            v: self
+                .modes
+                .v
+                .iter()
+                .map(|v| [v.clone(), v.clone()])
+                .collect(),
+        };
+        for (a, l) in self.a.iter_mut().zip(&self.modes.lam) {
+            *a *= (l * (t1 - t0)).exp();
         }
         step
     }
@@ -481,14 +520,14 @@ fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>
 /// The system for Rodas5P: the full Jacobian (module docs), taken from `cached` when the step
 /// starts where the last one ended (the adiabatic step differences it there anyway), else by
 /// Rodas5P's own differences.
-struct FullJacobian<'a> {
+struct SlowSystem<'a> {
     sys: &'a dyn OdeSystem,
     cached: Option<&'a (Vec<f64>, Mat<f64>)>,
     /// The ringing's mean forcing, held over the step (`mean_forcing`).
     forcing: Option<&'a [f64]>,
 }
 
-impl OdeSystem for FullJacobian<'_> {
+impl OdeSystem for SlowSystem<'_> {
     fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         self.sys.rhs(t, y, dy);
         if let Some(f) = self.forcing {
@@ -598,7 +637,7 @@ impl Adiabatic {
         // The mean forcing is kept (and recomputed every step) unless it is negligible:
         // below 1e-3 of the tolerance against f.
         let (f2, count) = mean_forcing(sys, &self.ys, &ringing);
-        self.extra_evaluations += count;
+        self.extra_evaluations += count + 1;
         let mut f = vec![0.0; y.len()];
         sys.rhs(0.0, &self.ys, &mut f);
         let size = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -610,7 +649,7 @@ impl Adiabatic {
         // Not negligible: the slow manifold is that of f + F₂ (else the forcing would act on
         // the slow run as a step and ring in it). Project again with it, and take the
         // ringing's amplitudes from there.
-        let forced = FullJacobian {
+        let forced = SlowSystem {
             sys,
             cached: None,
             forcing: Some(&f2),
@@ -648,7 +687,7 @@ impl Adiabatic {
                 // ends (the trapezoidal rule: second order in the forcing's drift, which
                 // a step held constant would get only to first order).
                 let (before, ys0) = (self.slow.clone(), self.ys.clone());
-                let predictor = FullJacobian {
+                let predictor = SlowSystem {
                     sys,
                     cached: self.jacobian.as_ref(),
                     forcing: Some(&f_start),
@@ -657,6 +696,7 @@ impl Adiabatic {
                 let mut t1 = t0;
                 self.slow.step(&predictor, &mut t1, &mut self.ys, t_end);
                 let proposed = self.slow.proposed_step();
+                self.extra_evaluations += self.slow.evaluations - before.evaluations;
                 let (f_end, count) = mean_forcing(sys, &self.ys, ringing);
                 self.extra_evaluations += count;
                 let mean: Vec<f64> = f_start
@@ -666,7 +706,7 @@ impl Adiabatic {
                     .collect();
                 self.slow = before;
                 self.ys = ys0;
-                let corrector = FullJacobian {
+                let corrector = SlowSystem {
                     sys,
                     cached: self.jacobian.as_ref(),
                     forcing: Some(&mean),
@@ -680,7 +720,7 @@ impl Adiabatic {
                 dense
             }
             (forcing, _) => {
-                let full = FullJacobian {
+                let full = SlowSystem {
                     sys,
                     cached: self.jacobian.as_ref(),
                     forcing: forcing.as_deref(),
@@ -700,13 +740,21 @@ impl Adiabatic {
         let j_end = self.forward(sys, &ys_end);
         let end = fast_modes(&j_end, self.threshold, Some(count));
         self.jacobian = Some((ys_end, j_end));
-        let (Some(end), Some(ringing)) = (end, self.ringing.as_mut()) else {
-            // The eigensolver failed: the ringing is dropped from here on (the slow motion
-            // goes on; its error control stays valid).
-            self.ringing = None;
+        let Some(ringing) = self.ringing.as_mut() else {
             return dense;
         };
-        let step = ringing.advance(t0, *t, end);
+        let step = match end.and_then(|e| ringing.advance(t0, *t, &e)) {
+            Some(step) => step,
+            None => {
+                // The eigensolver failed or the modes could not be matched: this step
+                // carries the ringing on the start's modes, and the next one splits the
+                // state afresh.
+                self.fresh = true;
+                self.jacobian = None;
+                self.forcing = None;
+                ringing.advance_frozen(t0, *t)
+            }
+        };
         for (yi, di) in y.iter_mut().zip(ringing.delta(n)) {
             *yi += di;
         }
@@ -754,10 +802,10 @@ mod tests {
             base[i][j]
         });
         let (lam, v, w) = eigen_both(&a).expect("eigen");
-        let mut complex_pairs = 0;
+        let mut complex = 0;
         for k in 0..5 {
             if lam[k].im != 0.0 {
-                complex_pairs += 1;
+                complex += 1;
             }
             for i in 0..5 {
                 let av: c64 = (0..5).map(|c| v[(c, k)] * a[(i, c)]).sum();
@@ -766,7 +814,7 @@ mod tests {
                 assert!((wa - lam[k] * w[(i, k)]).norm() < 1e-12, "left {k} {i}");
             }
         }
-        assert_eq!(complex_pairs, 4);
+        assert_eq!(complex, 4, "two conjugate pairs");
     }
 
     /// A second formulation: DOPRI5 at 1e-12 resolving every period. The state starts off
