@@ -233,11 +233,6 @@ impl Rodas5P {
         self.h
     }
 
-    /// Overrides the step size the controller proposes next, s.
-    pub(crate) fn set_proposed_step(&mut self, h: f64) {
-        self.h = h;
-    }
-
     /// Recompute the derivative at the current point, keeping the step size (after a change
     /// of the right-hand side that is not an impulse).
     pub(crate) fn refresh_derivative(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) {

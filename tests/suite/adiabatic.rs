@@ -82,8 +82,8 @@ fn seed_with_the_ideal_cable_matches_the_explicit_reference_in_few_steps() {
 /// The first impact sets the mast ringing at 2e-3 √kg·m, 250 times the release's, and the chain
 /// moves on: the state is split again under way, and the ringing's mean quadratic forcing
 /// acts on the slow run (left out, the second latch moved by 2.3e-6 relative). At
-/// tolerance 1e-8 against DOPRI5 at 1e-9: latch times to 5e-7 relative (8.7e-8 measured),
-/// rates and base impulses to 5e-5 (1.3e-5: the rates after the second impact are small,
+/// tolerance 1e-8 against DOPRI5 at 1e-9: latch times to 5e-7 relative (1.1e-9 measured),
+/// rates and base impulses to 5e-5 (1.4e-5: the rates after the second impact are small,
 /// 3.4e-3 rad/s), with fewer than 5 % of the evaluations (2.3 %).
 #[test]
 fn independent_hinges_latch_in_turn_as_in_the_explicit_reference() {
