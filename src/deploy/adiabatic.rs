@@ -52,6 +52,10 @@ use std::sync::Arc;
 /// Central-difference step for the decomposed Jacobian, relative to max(|y_i|, 1e-3).
 const CENTRAL_DELTA: f64 = 1e-6;
 
+/// Fixed-point iterations for the kinematic components of a fast eigenvector: each gains the
+/// factor |J_pp|/|λ| (the hub's rate over the fast frequency, below 1e-3 on the seed).
+const KINEMATIC_ITERATIONS: usize = 4;
+
 /// Newton iterations of the projection onto the slow manifold (two suffice on the seed:
 /// 4e-2 → 2e-9 → 7e-17).
 const PROJECTION_ITERATIONS: usize = 3;
@@ -78,19 +82,29 @@ fn dot_real(a: &[c64], x: &[f64]) -> c64 {
     a.iter().zip(x).map(|(p, q)| p * q).sum()
 }
 
-/// ∂f/∂y at y by central differences.
+/// ∂f/∂y at y by central differences (the kinematic columns from their rows alone, as in
+/// [`forward_jacobian`]).
 fn central_jacobian(sys: &dyn OdeSystem, y: &[f64]) -> Mat<f64> {
     let n = y.len();
+    let kin = sys.kinematic();
     let mut j = Mat::<f64>::zeros(n, n);
     let (mut fp, mut fm, mut yp) = (vec![0.0; n], vec![0.0; n], y.to_vec());
     for k in 0..n {
         let d = CENTRAL_DELTA * y[k].abs().max(1e-3);
+        let rows = if k < kin { kin } else { n };
+        let eval = |yp: &[f64], out: &mut [f64]| {
+            if k < kin {
+                sys.rhs_kinematic(0.0, yp, &mut out[..kin]);
+            } else {
+                sys.rhs(0.0, yp, out);
+            }
+        };
         yp[k] = y[k] + d;
-        sys.rhs(0.0, &yp, &mut fp);
+        eval(&yp, &mut fp);
         yp[k] = y[k] - d;
-        sys.rhs(0.0, &yp, &mut fm);
+        eval(&yp, &mut fm);
         yp[k] = y[k];
-        for i in 0..n {
+        for i in 0..rows {
             j[(i, k)] = (fp[i] - fm[i]) / (2.0 * d);
         }
     }
@@ -159,13 +173,20 @@ fn eigen_both(a: &Mat<f64>) -> Option<(Vec<c64>, Mat<c64>, Mat<c64>)> {
 }
 
 /// The `count` eigenvalues of J with the largest |Im λ| (all those above `threshold` when
-/// `count` is None), with their right and left eigenvectors. Coordinates whose columns of J
-/// are zero (the hub's position and attitude: the dynamics do not depend on them) are left
-/// out of the eigenproblem: for λ ≠ 0 their left components vanish and their right ones
-/// follow from their rows, v_p = J_p,r v_r / λ. None when the eigensolver fails.
-fn fast_modes(j: &Mat<f64>, threshold: f64, count: Option<usize>) -> Option<FastModes> {
+/// `count` is None), with their right and left eigenvectors. The first `kinematic`
+/// coordinates (the hub's position and attitude, [`OdeSystem::kinematic`]) and those whose
+/// columns of J are zero are left out of the eigenproblem: they feed no other row, so for
+/// λ ≠ 0 their left components vanish and their right ones follow from their rows,
+/// (λ − J_pp) v_p = J_p,r v_r (by fixed-point iteration: |J_pp| is the hub's rate, far
+/// below the fast |λ|). None when the eigensolver fails.
+fn fast_modes(
+    j: &Mat<f64>,
+    kinematic: usize,
+    threshold: f64,
+    count: Option<usize>,
+) -> Option<FastModes> {
     let n = j.nrows();
-    let kept: Vec<usize> = (0..n)
+    let kept: Vec<usize> = (kinematic..n)
         .filter(|&c| (0..n).any(|r| j[(r, c)] != 0.0))
         .collect();
     let ignored: Vec<usize> = (0..n).filter(|c| !kept.contains(c)).collect();
@@ -193,9 +214,19 @@ fn fast_modes(j: &Mat<f64>, threshold: f64, count: Option<usize>) -> Option<Fast
             v[i] = right[(r, a)];
             w[i] = left[(r, a)];
         }
-        for &p in &ignored {
-            let jv: c64 = kept.iter().map(|&i| v[i] * j[(p, i)]).sum();
-            v[p] = jv / l;
+        let fed: Vec<c64> = ignored
+            .iter()
+            .map(|&p| kept.iter().map(|&i| v[i] * j[(p, i)]).sum())
+            .collect();
+        for _ in 0..KINEMATIC_ITERATIONS {
+            let next: Vec<c64> = ignored
+                .iter()
+                .zip(&fed)
+                .map(|(&p, f)| (f + ignored.iter().map(|&q| v[q] * j[(p, q)]).sum::<c64>()) / l)
+                .collect();
+            for (&p, x) in ignored.iter().zip(next) {
+                v[p] = x;
+            }
         }
         let wv = dot(&w, &v);
         if wv.norm() == 0.0 || !wv.re.is_finite() {
@@ -310,7 +341,7 @@ fn integrate(ts: &[f64], ls: &[c64], a: f64, b: f64) -> c64 {
 /// (|Im λ| > `threshold`, rad/s), to first order in the slow motion's rate (module docs), and
 /// the number of fast eigenvalues; None when the eigensolver fails.
 pub fn slow_manifold(sys: &dyn OdeSystem, y: &[f64], threshold: f64) -> Option<(Vec<f64>, usize)> {
-    let modes = fast_modes(&central_jacobian(sys, y), threshold, None)?;
+    let modes = fast_modes(&central_jacobian(sys, y), sys.kinematic(), threshold, None)?;
     let count = modes.lam.len();
     Some((project(sys, y, &modes), count))
 }
@@ -567,6 +598,17 @@ impl OdeSystem for SlowSystem<'_> {
             }
         }
     }
+    fn kinematic(&self) -> usize {
+        self.sys.kinematic()
+    }
+    fn rhs_kinematic(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.sys.rhs_kinematic(t, y, dy);
+        if let Some(f) = self.forcing {
+            for (d, g) in dy.iter_mut().zip(f) {
+                *d += g;
+            }
+        }
+    }
     fn jacobian(&self, _t: f64, y: &[f64], jac: &mut Mat<f64>) -> bool {
         match self.cached {
             Some((at, j)) if at.as_slice() == y => {
@@ -637,7 +679,7 @@ impl Adiabatic {
     fn forward(&mut self, sys: &dyn OdeSystem, y: &[f64]) -> Mat<f64> {
         let mut f0 = vec![0.0; y.len()];
         sys.rhs(0.0, y, &mut f0);
-        self.extra_evaluations += y.len() + 1;
+        self.extra_evaluations += y.len() - sys.kinematic() + 1;
         forward_jacobian(sys, 0.0, y, &f0)
     }
 
@@ -649,8 +691,13 @@ impl Adiabatic {
         self.forcing = None;
         self.forcing_slope = None;
         self.ys = y.to_vec();
-        self.extra_evaluations += 2 * y.len();
-        let Some(at_y) = fast_modes(&central_jacobian(sys, y), self.threshold, None) else {
+        self.extra_evaluations += 2 * (y.len() - sys.kinematic());
+        let Some(at_y) = fast_modes(
+            &central_jacobian(sys, y),
+            sys.kinematic(),
+            self.threshold,
+            None,
+        ) else {
             return;
         };
         if at_y.lam.is_empty() {
@@ -663,8 +710,13 @@ impl Adiabatic {
         if !ys.iter().all(|v| v.is_finite()) {
             return;
         }
-        self.extra_evaluations += 2 * y.len();
-        let Some(all) = fast_modes(&central_jacobian(sys, &ys), self.threshold, Some(count)) else {
+        self.extra_evaluations += 2 * (y.len() - sys.kinematic());
+        let Some(all) = fast_modes(
+            &central_jacobian(sys, &ys),
+            sys.kinematic(),
+            self.threshold,
+            Some(count),
+        ) else {
             return;
         };
         let modes = all.clone();
@@ -797,7 +849,7 @@ impl Adiabatic {
         let count = self.fast_count;
         let ys_end = self.ys.clone();
         let j_end = self.forward(sys, &ys_end);
-        let end = fast_modes(&j_end, self.threshold, Some(count));
+        let end = fast_modes(&j_end, sys.kinematic(), self.threshold, Some(count));
         self.jacobian = Some((ys_end, j_end));
         let Some(ringing) = self.ringing.as_mut() else {
             return dense;

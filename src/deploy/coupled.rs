@@ -1042,6 +1042,29 @@ impl Coupled {
         self.rhs_captured(y, free, &vec![false; self.panels()], dy);
     }
 
+    /// The free hub's position and attitude quaternion, the first 7 positions (none with a
+    /// held hub): nothing else in dy/dt depends on them (the dynamics are written in the hub
+    /// frame, and nothing acts on the spacecraft from outside).
+    pub fn kinematic_positions(&self) -> usize {
+        if self.hub_dof() == 6 {
+            7
+        } else {
+            0
+        }
+    }
+
+    /// Their rates, ṙ = A(q) v and q̇ = ½ q ⊗ (0, ω), into `dy` (of length
+    /// [`Coupled::kinematic_positions`]).
+    pub fn hub_kinematics(&self, y: &[f64], dy: &mut [f64]) {
+        if self.hub_dof() == 6 {
+            let s = self.view(y);
+            let rd = attitude::matrix(s.quat).apply(s.v);
+            let qd = attitude::rate(s.quat, s.w);
+            dy[..3].copy_from_slice(&rd.0);
+            dy[3..7].copy_from_slice(&qd);
+        }
+    }
+
     /// dy/dt for the hinges flagged free, the compliant latches of those flagged `captured`
     /// acting.
     /// Evaluates into a workspace kept per thread: no allocation once it is sized.
@@ -1056,15 +1079,9 @@ impl Coupled {
             self.eliminate_chain(ws, &ws.force, sw, free, &mut dy[np..]);
         });
         let s = self.view(y);
-        let (h, m) = (self.hub_dof(), self.modes());
-        if h == 6 {
-            let a = attitude::matrix(s.quat);
-            let rd = a.apply(s.v);
-            let qd = attitude::rate(s.quat, s.w);
-            dy[..3].copy_from_slice(&rd.0);
-            dy[3..7].copy_from_slice(&qd);
-        }
-        let pe = if h == 6 { 7 } else { 0 };
+        let m = self.modes();
+        let pe = self.kinematic_positions();
+        self.hub_kinematics(y, &mut dy[..pe]);
         dy[pe..pe + m].copy_from_slice(s.eta_dot);
         for (i, r) in s.alpha_dot.iter().enumerate() {
             dy[pe + m + i] = *r;

@@ -35,6 +35,15 @@ pub trait OdeSystem {
     fn jacobian(&self, _t: f64, _y: &[f64], _jac: &mut faer::Mat<f64>) -> bool {
         false
     }
+    /// The number k of leading components of y that are kinematic: they enter f only
+    /// through its first k rows (a free hub's position and attitude, on which the dynamics in
+    /// the hub frame do not depend). A Jacobian by differences takes their columns from
+    /// [`OdeSystem::rhs_kinematic`] alone. Zero by default.
+    fn kinematic(&self) -> usize {
+        0
+    }
+    /// The first [`OdeSystem::kinematic`] components of f(t, y) into `dy` (of that length).
+    fn rhs_kinematic(&self, _t: f64, _y: &[f64], _dy: &mut [f64]) {}
 }
 
 const C2: f64 = 1.0 / 5.0;

@@ -286,6 +286,12 @@ impl Engine for Coupled {
     fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
         self.rhs_captured(y, free, captured, dy);
     }
+    fn kinematic(&self) -> usize {
+        self.kinematic_positions()
+    }
+    fn rhs_kinematic(&self, y: &[f64], dy: &mut [f64]) {
+        self.hub_kinematics(y, dy);
+    }
     fn jacobian(
         &self,
         y: &[f64],

@@ -169,10 +169,13 @@ const B: [f64; STAGES] = [
     1.0,
 ];
 
-/// ∂f/∂y at (t, y) by forward differences (n evaluations), f0 = f(t, y): column c from the
-/// step JAC_DELTA·max(|y_c|, 1), as represented.
+/// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y): column c from the step
+/// JAC_DELTA·max(|y_c|, 1), as represented. The columns of the kinematic components
+/// ([`OdeSystem::kinematic`]) come from their rows alone (zero below); the others cost one
+/// evaluation each.
 pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64]) -> Mat<f64> {
     let n = y.len();
+    let k = sys.kinematic();
     let mut j = Mat::zeros(n, n);
     let mut yp = y.to_vec();
     let mut fp = vec![0.0; n];
@@ -180,8 +183,14 @@ pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64
         let d = JAC_DELTA * y[c].abs().max(1.0);
         yp[c] = y[c] + d;
         let d = yp[c] - y[c]; // the representable step
-        sys.rhs(t, &yp, &mut fp);
-        for r in 0..n {
+        let rows = if c < k {
+            sys.rhs_kinematic(t, &yp, &mut fp[..k]);
+            k
+        } else {
+            sys.rhs(t, &yp, &mut fp);
+            n
+        };
+        for r in 0..rows {
             j[(r, c)] = (fp[r] - f0[r]) / d;
         }
         yp[c] = y[c];
@@ -244,7 +253,7 @@ impl Rodas5P {
 
     /// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y).
     fn jacobian(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> Mat<f64> {
-        self.evaluations += y.len();
+        self.evaluations += y.len() - sys.kinematic();
         forward_jacobian(sys, t, y, &self.f0)
     }
 

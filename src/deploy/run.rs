@@ -73,6 +73,12 @@ pub(crate) trait Engine {
     ) -> bool {
         false
     }
+    /// The leading kinematic components of y ([`OdeSystem::kinematic`]); none by default.
+    fn kinematic(&self) -> usize {
+        0
+    }
+    /// Their rows of dy/dt.
+    fn rhs_kinematic(&self, _y: &[f64], _dy: &mut [f64]) {}
     /// Load magnitudes whose peaks the run tracks at every step ([`super::peaks`]); none by
     /// default.
     fn load_magnitudes(&self, _y: &[f64], _free: &[bool], _captured: &[bool]) -> Vec<f64> {
@@ -235,6 +241,12 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     }
     fn jacobian(&self, _t: f64, y: &[f64], jac: &mut faer::Mat<f64>) -> bool {
         self.engine.jacobian(y, &self.free, &self.captured, jac)
+    }
+    fn kinematic(&self) -> usize {
+        self.engine.kinematic()
+    }
+    fn rhs_kinematic(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+        self.engine.rhs_kinematic(y, dy);
     }
 }
 
