@@ -23,7 +23,7 @@
 //!   c_j = w_jᵀ δ(0) constant once the eigenvectors are parallel-transported
 //!   ((w_j(t_k) + w_j(t_{k+1}))ᵀ (v_j(t_{k+1}) − v_j(t_k)) = 0). J is differenced at every
 //!   slow step's end (and serves the next Rodas5P step), the carried modes followed onto it
-//!   by inverse iteration ([`track`]; the whole decomposition when that fails); modes are
+//!   by inverse iteration (`track`; the whole decomposition when that fails); modes are
 //!   matched across steps by the overlap w_jᵀ v_k, not by the nearest eigenvalue (the
 //!   in-plane and out-of-plane bending frequencies cross as the panels open); θ_j integrates
 //!   the cubic through λ_j at the last four step ends, and within a step v_j is linear
