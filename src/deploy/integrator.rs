@@ -129,6 +129,20 @@ impl DenseStep {
         }
     }
 
+    /// Components `first..first + out.len()` of y(t) (the ringing's phases computed once).
+    pub fn components(&self, first: usize, t: f64, out: &mut [f64]) {
+        let s = (t - self.t0) / self.h;
+        let s1 = 1.0 - s;
+        for (k, o) in out.iter_mut().enumerate() {
+            let i = first + k;
+            *o = self.r[0][i]
+                + s * (self.r[1][i] + s1 * (self.r[2][i] + s * (self.r[3][i] + s1 * self.r[4][i])));
+        }
+        if let Some(r) = &self.ringing {
+            r.add_range_to(t, first, out);
+        }
+    }
+
     /// Component i of y(t).
     pub fn component(&self, i: usize, t: f64) -> f64 {
         let s = (t - self.t0) / self.h;

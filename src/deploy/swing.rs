@@ -66,22 +66,28 @@ impl SwingTracker {
     /// has its first time located on the dense output.
     pub fn scan(&mut self, step: &DenseStep, offset: usize, t_seen: f64) {
         let t_start = step.t0;
-        for i in 0..self.initial.len() {
-            let a0 = self.initial[i];
-            let g = |tt: f64| a0 - MARGIN - step.component(offset + i, tt);
-            let mut a = t_start;
-            for s in 1..=SUBDIVISIONS {
-                let b = t_start + (t_seen - t_start) * f64::from(s) / f64::from(SUBDIVISIONS);
-                if g(b) > 0.0 {
-                    let first = if self.found[i].is_none() && g(a) <= 0.0 {
+        let n = self.initial.len();
+        // The angles at the subdivision points, all hinges at once.
+        let (mut before, mut now) = (vec![0.0; n], vec![0.0; n]);
+        step.components(offset, t_start, &mut before);
+        let mut a = t_start;
+        for s in 1..=SUBDIVISIONS {
+            let b = t_start + (t_seen - t_start) * f64::from(s) / f64::from(SUBDIVISIONS);
+            step.components(offset, b, &mut now);
+            for i in 0..n {
+                let a0 = self.initial[i];
+                if a0 - MARGIN - now[i] > 0.0 {
+                    let first = if self.found[i].is_none() && a0 - MARGIN - before[i] <= 0.0 {
+                        let g = |tt: f64| a0 - MARGIN - step.component(offset + i, tt);
                         locate(g, a, b, EVENT_TOL * b.abs().max(1.0))
                     } else {
                         b
                     };
-                    self.record(i, first, step.component(offset + i, b));
+                    self.record(i, first, now[i]);
                 }
-                a = b;
             }
+            std::mem::swap(&mut before, &mut now);
+            a = b;
         }
     }
 
@@ -98,5 +104,45 @@ impl SwingTracker {
             })
             .collect();
         (found, warnings)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step on [2, 6] whose three angles (components 1..4 of y) are linear: hinge 1 falls
+    /// from 0.101 to 0.097 against its initial 0.1, so it swings back from t = 3 on (closed
+    /// form: 0.101 − 0.001 (t − 2) = 0.1 − MARGIN); hinge 2 stays above its initial angle;
+    /// hinge 3 starts below its own and falls further. The scan locates hinge 1's first time
+    /// and records the least angle seen at the subdivision points.
+    #[test]
+    fn a_falling_angle_is_caught_where_it_crosses_its_initial_value() {
+        let start = vec![9.0, 0.101, 0.5, 0.29];
+        let end = vec![9.0, 0.097, 0.6, 0.25];
+        let slope: Vec<f64> = start.iter().zip(&end).map(|(a, b)| b - a).collect();
+        let zero = vec![0.0; 4];
+        let step = DenseStep::from_coefficients(
+            2.0,
+            4.0,
+            [start, slope, zero.clone(), zero.clone(), zero],
+        );
+        let mut tracker = SwingTracker::new(vec![0.1, 0.4, 0.3]);
+        tracker.scan(&step, 1, 6.0);
+        let (found, warnings) = tracker.finish();
+        assert_eq!(found.len(), 2);
+        assert_eq!(warnings.len(), 2);
+        let first = 2.0 + (0.001 + MARGIN) / 0.001;
+        assert_eq!(found[0].hinge, 1);
+        assert!(
+            (found[0].first_time - first).abs() <= 1e-9,
+            "{}",
+            found[0].first_time
+        );
+        assert!((found[0].min_angle - 0.097).abs() <= 1e-15);
+        assert_eq!(found[1].hinge, 3);
+        // Already below at the step's start: its first time is the first subdivision.
+        assert!((found[1].first_time - 2.5).abs() <= 1e-15);
+        assert!((found[1].min_angle - 0.25).abs() <= 1e-15);
     }
 }
