@@ -366,7 +366,7 @@ fn track(
 /// The most carried mode pairs that are tracked ([`track`]); with more, their complex LUs
 /// cost more than one whole decomposition (measured: an LU costs 1/25 of the decomposition
 /// at n = 24 and 52, 1/19 at n = 166, and the iterations add their solves).
-const TRACK_PAIRS: usize = 8;
+const TRACK_PAIRS: usize = 12;
 
 /// Inverse iterations per tracked mode at most (one LU, two solves each).
 const TRACK_ITERATIONS: usize = 8;
@@ -432,7 +432,7 @@ fn project(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes) -> Vec<f64> {
 
 /// A ringing mode is carried while some component of it exceeds this fraction of the error
 /// tolerance (atol + rtol |y_i|); below, the slow run's L-stable steps damp it.
-const NEGLIGIBLE_RINGING: f64 = 1e-3;
+const NEGLIGIBLE_RINGING: f64 = 1e-2;
 
 /// Whether the projection of y onto the slow manifold, `ys`, is one: finite, and f there
 /// not larger than at y (max norms, with a factor 10 of room). The projection takes the
