@@ -1011,7 +1011,11 @@ impl Coupled {
     /// Linear momentum (N·s) and angular momentum about the system's centre of mass (N·m·s),
     /// inertial components, and the centre of mass (inertial, m).
     pub fn momentum(&self, y: &[f64]) -> (Vec3, Vec3, Vec3) {
-        let ev = self.evaluate(y);
+        // Kinematics only: the per-thread workspace, without the dense mass matrix.
+        let ev = WORKSPACE.with_borrow_mut(|(ws, _)| {
+            self.assemble_parts(y, ws, false);
+            ws.to_eval(self)
+        });
         let s = self.view(y);
         let inv = &self.base.invariants;
         let (pb, hb) = inv.momenta(&ev.at, s.v, s.w, s.eta_dot);

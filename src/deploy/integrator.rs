@@ -44,6 +44,18 @@ pub trait OdeSystem {
     }
     /// The first [`OdeSystem::kinematic`] components of f(t, y) into `dy` (of that length).
     fn rhs_kinematic(&self, _t: f64, _y: &[f64], _dy: &mut [f64]) {}
+    /// Quantities the exact flow conserves, and on which components of y they depend
+    /// linearly (none by default): a free-floating spacecraft's linear and angular momentum,
+    /// linear in the hub's velocity and rate. A stepper that does not conserve them by
+    /// itself restores them after every step by correcting those components (a projection
+    /// method).
+    fn invariants(&self, _y: &[f64]) -> Vec<f64> {
+        Vec::new()
+    }
+    /// The components of y [`OdeSystem::invariants`] are corrected through.
+    fn invariant_coordinates(&self) -> Vec<usize> {
+        Vec::new()
+    }
 }
 
 const C2: f64 = 1.0 / 5.0;

@@ -292,6 +292,23 @@ impl Engine for Coupled {
     fn rhs_kinematic(&self, y: &[f64], dy: &mut [f64]) {
         self.hub_kinematics(y, dy);
     }
+    fn invariants(&self, y: &[f64]) -> Vec<f64> {
+        if self.hub_dof() < 6 {
+            return Vec::new();
+        }
+        // Nothing acts from outside a free hub: P and L about the centre of mass are
+        // conserved (through impacts and captures too: their impulses are internal).
+        let (p, l, _) = self.momentum(y);
+        p.0.iter().chain(&l.0).copied().collect()
+    }
+    fn invariant_coordinates(&self) -> Vec<usize> {
+        if self.hub_dof() < 6 {
+            return Vec::new();
+        }
+        // The hub's velocity and rate, the first six speeds.
+        let np = self.positions();
+        (np..np + 6).collect()
+    }
     fn jacobian(
         &self,
         y: &[f64],

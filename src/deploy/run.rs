@@ -79,6 +79,14 @@ pub(crate) trait Engine {
     }
     /// Their rows of dy/dt.
     fn rhs_kinematic(&self, _y: &[f64], _dy: &mut [f64]) {}
+    /// Conserved quantities ([`OdeSystem::invariants`]); none by default.
+    fn invariants(&self, _y: &[f64]) -> Vec<f64> {
+        Vec::new()
+    }
+    /// The components of y they are restored through.
+    fn invariant_coordinates(&self) -> Vec<usize> {
+        Vec::new()
+    }
     /// Load magnitudes whose peaks the run tracks at every step ([`super::peaks`]); none by
     /// default.
     fn load_magnitudes(&self, _y: &[f64], _free: &[bool], _captured: &[bool]) -> Vec<f64> {
@@ -202,6 +210,13 @@ impl Stepper {
             Self::Adiabatic(s) => s.step(sys, t, y, t_end),
         }
     }
+    /// A state taken from the dense output (an event's) with its conserved quantities
+    /// restored, for the stepper that restores them after every step.
+    fn conserve(&mut self, sys: &dyn OdeSystem, y: &mut [f64]) {
+        if let Self::Adiabatic(s) = self {
+            s.conserve(sys, y);
+        }
+    }
     fn restart(&mut self) {
         match self {
             Self::Explicit(s) => s.restart(),
@@ -247,6 +262,12 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     }
     fn rhs_kinematic(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
         self.engine.rhs_kinematic(y, dy);
+    }
+    fn invariants(&self, y: &[f64]) -> Vec<f64> {
+        self.engine.invariants(y)
+    }
+    fn invariant_coordinates(&self) -> Vec<usize> {
+        self.engine.invariant_coordinates()
     }
 }
 
@@ -369,6 +390,7 @@ impl<'a, E: Engine> Run<'a, E> {
         let off = engine.alpha_offset();
         let ro = engine.positions() + engine.rate_offset();
         step.eval(e.t, &mut self.y);
+        self.solver.conserve(&self.sys, &mut self.y);
         self.t = e.t;
         self.observe_loads();
         self.peaks.break_history();
@@ -440,6 +462,7 @@ impl<'a, E: Engine> Run<'a, E> {
         let off = engine.alpha_offset();
         let np = engine.positions();
         step.eval(e.t, &mut self.y);
+        self.solver.conserve(&self.sys, &mut self.y);
         self.t = e.t;
         let cable = engine.ideal_cable();
         let all = cable || self.s.latching == Latching::Simultaneous;
