@@ -336,6 +336,11 @@ pub struct DeploymentResult {
 }
 
 impl DeploymentResult {
+    /// The whole state at `final_time`, y = [q, q̇].
+    pub fn final_state(&self) -> Vec<f64> {
+        self.final_q.iter().chain(&self.final_qd).copied().collect()
+    }
+
     /// The integration produced a non-finite state and was stopped at `final_time`.
     pub fn diverged(&self) -> bool {
         matches!(self.status, RunStatus::Diverged { .. })

@@ -528,12 +528,7 @@ pub fn hand_over_coupled(
         .unwrap_or(0);
     let view = PlateView::find(model, &deployment.plate)?;
     let n = model.dof();
-    let y: Vec<f64> = result
-        .final_q
-        .iter()
-        .chain(&result.final_qd)
-        .copied()
-        .collect();
+    let y = result.final_state();
     let (base_velocity, q0) = base_state(coupled, model, &y);
     let pl = coupled_pre_latch(coupled, &y, view.plate.length_axis, base_velocity);
     let mut notes = Vec::new();

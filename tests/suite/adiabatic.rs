@@ -158,13 +158,7 @@ fn the_free_spacecraft_keeps_zero_momentum_through_latch_and_capture() {
         let (model, result) = simulate_coupled(&sc.structure, &d).unwrap();
         assert!(result.all_latched, "{example}");
         let panel = 50.0 * 0.2425;
-        let y: Vec<f64> = result
-            .final_q
-            .iter()
-            .chain(&result.final_qd)
-            .copied()
-            .collect();
-        let (p, l, _) = model.momentum(&y);
+        let (p, l, _) = model.momentum(&result.final_state());
         assert!(
             norm(p.0) <= 1e-9 * panel,
             "{example}: P = {:?} at the end",
