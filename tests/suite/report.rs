@@ -135,6 +135,31 @@ fn pixels(path: &Path) -> Vec<u8> {
         .into_raw()
 }
 
+/// Chromium's profile folders of one test, in the temporary directory, removed when the
+/// test ends (passed or failed).
+#[derive(Default)]
+struct Profiles(std::cell::RefCell<Vec<std::path::PathBuf>>);
+
+impl Profiles {
+    /// The `--user-data-dir` argument of a fresh profile folder named by `tag`.
+    fn arg(&self, tag: &str) -> String {
+        let d =
+            std::env::temp_dir().join(format!("flexcraft-chromium-{}-{tag}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        let arg = format!("--user-data-dir={}", d.display());
+        self.0.borrow_mut().push(d);
+        arg
+    }
+}
+
+impl Drop for Profiles {
+    fn drop(&mut self) {
+        for d in self.0.borrow().iter() {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
+}
+
 /// Headless Chromium: the page runs without a script error, hovering a chart shows a
 /// readout and dragging zooms it, its screenshot is not blank, and the animation's first and
 /// last frames differ. Needs `chromium` (.ci/run installs
@@ -148,12 +173,8 @@ fn browser_renders_the_report_without_errors_and_animates() {
         .expect("chromium not found: .ci/run installs Debian's chromium");
     let (_, out) = simulate("seed.toml", "browser");
     let page = format!("file://{}", out.join("report.html").display());
-    let profile = |tag: &str| {
-        let d =
-            std::env::temp_dir().join(format!("flexcraft-chromium-{}-{tag}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        format!("--user-data-dir={}", d.display())
-    };
+    let profiles = Profiles::default();
+    let profile = |tag: &str| profiles.arg(tag);
     let base = [
         "--headless",
         "--no-sandbox",
