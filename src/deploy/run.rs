@@ -390,7 +390,6 @@ impl<'a, E: Engine> Run<'a, E> {
         let off = engine.alpha_offset();
         let ro = engine.positions() + engine.rate_offset();
         step.eval(e.t, &mut self.y);
-        self.solver.conserve(&self.sys, &mut self.y);
         self.t = e.t;
         self.observe_loads();
         self.peaks.break_history();
@@ -411,6 +410,7 @@ impl<'a, E: Engine> Run<'a, E> {
         }
         // The hinge sits on its latch angle (to the event tolerance): put it there exactly.
         self.y[off + e.hinge] = self.latch_angles[e.hinge];
+        self.solver.conserve(&self.sys, &mut self.y);
         self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
             self.samples
@@ -462,7 +462,6 @@ impl<'a, E: Engine> Run<'a, E> {
         let off = engine.alpha_offset();
         let np = engine.positions();
         step.eval(e.t, &mut self.y);
-        self.solver.conserve(&self.sys, &mut self.y);
         self.t = e.t;
         let cable = engine.ideal_cable();
         let all = cable || self.s.latching == Latching::Simultaneous;
@@ -479,6 +478,7 @@ impl<'a, E: Engine> Run<'a, E> {
                 self.y[off + j] = self.latch_angles[j];
             }
         }
+        self.solver.conserve(&self.sys, &mut self.y);
         if all && !cable {
             self.bent_lock_warning(e);
         }

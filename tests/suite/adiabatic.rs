@@ -141,11 +141,12 @@ fn compliant_latches_capture_as_in_the_explicit_reference() {
 /// through the latch (seed: one plastic impact of all three hinges) or the capture and the
 /// settling (seed_compliant). The adiabatic run restores them after every step and at the
 /// located event (a projection method): at the final state (where the hand-over starts)
-/// they are zero to 1e-9 of the largest panel momentum (50 kg at 0.2425 m/s), as the issue
-/// asks of the coupled model. Between step ends, in the samples, the step's own error
-/// remains: below 1e-4 of it (measured 1.6e-6 on the seed, 4.3e-5 on seed_compliant, where
-/// the latch mode at 15.6 rad/s is not slow against the mast's 109 rad/s); without the
-/// restoration it accumulated to 4.6e-3 N·s (3.8e-4) on seed_compliant.
+/// they are zero to 1e-9 of the largest panel momentum (50 kg at 0.2425 m/s; for L, times
+/// the panel's 5 m), as the issue asks of the coupled model. Between step ends, in the
+/// samples, the step's own error remains: below 3e-4 of those scales (measured on the seed
+/// 1.6e-6 in P and 4.9e-6 in L; on seed_compliant, where the latch mode at 15.6 rad/s is not
+/// slow against the mast's 109 rad/s, 4.3e-5 and 1.2e-4); without the restoration P
+/// accumulated to 4.6e-3 N·s (3.8e-4) on seed_compliant.
 #[test]
 fn the_free_spacecraft_keeps_zero_momentum_through_latch_and_capture() {
     for example in ["seed.toml", "seed_compliant.toml"] {
@@ -164,8 +165,9 @@ fn the_free_spacecraft_keeps_zero_momentum_through_latch_and_capture() {
             "{example}: P = {:?} at the end",
             p.0
         );
+        // L against a panel's momentum times its length (5 m).
         assert!(
-            norm(l.0) <= 1e-9 * panel * 1.0,
+            norm(l.0) <= 1e-9 * panel * 5.0,
             "{example}: L = {:?} at the end",
             l.0
         );
@@ -174,10 +176,10 @@ fn the_free_spacecraft_keeps_zero_momentum_through_latch_and_capture() {
             let b = s.body.as_ref().unwrap();
             worst = worst
                 .max(norm(b.momentum))
-                .max(norm(b.angular_momentum) / 15.0);
+                .max(norm(b.angular_momentum) / 5.0);
         }
         assert!(
-            worst <= 1e-4 * panel,
+            worst <= 3e-4 * panel,
             "{example}: {worst} N·s between step ends"
         );
     }
