@@ -89,6 +89,11 @@ fn dot_real(a: &[c64], x: &[f64]) -> c64 {
     a.iter().zip(x).map(|(p, q)| p * q).sum()
 }
 
+/// max_i |v_i|, the norm the module's criteria use.
+fn max_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
 /// ∂f/∂y at y by central differences (the kinematic columns from their rows alone, as in
 /// [`forward_jacobian`]).
 fn central_jacobian(sys: &dyn OdeSystem, y: &[f64]) -> Mat<f64> {
@@ -452,7 +457,7 @@ fn projected(sys: &dyn OdeSystem, y: &[f64], ys: &[f64]) -> bool {
     let size = |x: &[f64]| {
         let mut f = vec![0.0; x.len()];
         sys.rhs(0.0, x, &mut f);
-        f.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        max_norm(&f)
     };
     size(ys) <= 10.0 * size(y)
 }
@@ -756,7 +761,7 @@ fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>
                 }
             }
         }
-        share[j] = pair.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        share[j] = max_norm(&pair);
         for (o, p) in out.iter_mut().zip(&pair) {
             *o += p;
         }
@@ -942,9 +947,8 @@ impl Adiabatic {
         self.extra_evaluations += count + 1;
         let mut f = vec![0.0; y.len()];
         sys.rhs(0.0, &self.ys, &mut f);
-        let size = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let budget = 1e-3 * self.slow.rtol * size(&f);
-        if size(&f2) <= budget {
+        let budget = 1e-3 * self.slow.rtol * max_norm(&f);
+        if max_norm(&f2) <= budget {
             self.forcing = None;
             self.ringing = Some(ringing);
             return;
@@ -1059,13 +1063,12 @@ impl Adiabatic {
                 .map(|(t, v)| t - v)
                 .collect()
         };
-        let size = |r: &[f64]| r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut r = residual(y);
         self.extra_evaluations += 1;
         // A residual growing from step to step means the kept Jacobian no longer contracts
         // it (the inertia has changed): difference it afresh.
-        let growing = size(&r) > 4.0 * self.restore_residual;
-        self.restore_residual = size(&r);
+        let growing = max_norm(&r) > 4.0 * self.restore_residual;
+        self.restore_residual = max_norm(&r);
         if growing && self.restore_age > 0 {
             self.invariant_jacobian = None;
         }
@@ -1075,7 +1078,7 @@ impl Adiabatic {
         // change, so iterate while that pays, and refresh it when it no longer contracts
         // by 1e-3.
         for _ in 0..if tight { RESTORE_ITERATIONS } else { 1 } {
-            if size(&r) == 0.0 {
+            if max_norm(&r) == 0.0 {
                 break;
             }
             let g = match self.invariant_jacobian.take() {
@@ -1112,14 +1115,14 @@ impl Adiabatic {
             }
             let next = residual(y);
             self.extra_evaluations += 1;
-            if size(&next) >= size(&r) {
+            if max_norm(&next) >= max_norm(&r) {
                 // Rounding reached (or a useless Jacobian): undo this iteration.
                 for (&k, v) in coords.iter().zip(kept) {
                     y[k] = v;
                 }
                 break;
             }
-            if size(&next) <= 1e-3 * size(&r) {
+            if max_norm(&next) <= 1e-3 * max_norm(&r) {
                 self.invariant_jacobian = Some(g);
             }
             r = next;
