@@ -67,6 +67,15 @@ pub enum Warning {
     /// Rigid latches on an elastic base: the latch outcome with half of the kept base modes
     /// (the latch with the largest change of the base impulse).
     RigidLatchTruncation(crate::deploy::HalfModes),
+    /// Compliant latches still moving when the settling's cap ended the deployment.
+    NotSettled {
+        /// The end of the settling, s.
+        t: f64,
+        /// The largest captured-hinge rate in the last window over the largest at a capture.
+        ratio: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
     /// The array locked away from the straight wing; the hand-over uses the straight wing.
     AngleMismatch {
         /// Largest hinge-angle mismatch, rad.
@@ -136,6 +145,19 @@ impl fmt::Display for Warning {
                 f,
                 "response.modes = {requested} but the model has {available} elastic modes: all \
                  of them are kept"
+            ),
+            Self::NotSettled {
+                t,
+                ratio,
+                tolerance,
+            } => write!(
+                f,
+                "the latches had not settled when the deployment handed over at t = {t} s: the \
+                 hinge rates were still {:.2} % of the largest rate at a capture (settled means \
+                 below {:.2} %); the latch springs' remaining motion is not in the response. Add \
+                 latch damping or set [deployment.latch] settle_time",
+                100.0 * ratio,
+                100.0 * tolerance
             ),
             Self::LocksBent { t, hinge, rad } => write!(
                 f,

@@ -545,6 +545,23 @@ impl RingingStep {
         })
     }
 
+    /// The fastest carried mode's angular frequency at the step's end, |Im λ|, rad/s.
+    pub fn fastest(&self) -> f64 {
+        self.lam
+            .iter()
+            .filter_map(|l| l.last())
+            .fold(0.0, |m: f64, l| m.max(l.im.abs()))
+    }
+
+    /// The slowest carried mode's angular frequency at the step's end, |Im λ|, rad/s
+    /// (infinite without modes).
+    pub fn slowest(&self) -> f64 {
+        self.lam
+            .iter()
+            .filter_map(|l| l.last())
+            .fold(f64::INFINITY, |m: f64, l| m.min(l.im.abs()))
+    }
+
     /// Component i of δ(t).
     pub fn component(&self, i: usize, t: f64) -> f64 {
         self.weights(t)

@@ -1714,10 +1714,10 @@ impl Coupled {
             tolerance: tol,
             integrator: super::Integrator::Explicit,
             record_samples: true,
-            settle_time: self
+            settle: self
                 .latch
                 .as_ref()
-                .map(|l| super::settle_time_default(&self.chain, &l.stiffness)),
+                .map(|l| super::Settle::decayed(&self.chain, &l.stiffness)),
         };
         let r = super::run::run(self, &settings, super::MAX_STEPS);
         let latches = r

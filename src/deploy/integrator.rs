@@ -123,6 +123,21 @@ impl DenseStep {
         self.ringing = Some(ringing);
     }
 
+    /// The fastest angular frequency the ringing carried beside the polynomial has, rad/s
+    /// (0 without ringing): the polynomial follows the accepted steps, the ringing does not.
+    pub fn fastest_ringing(&self) -> f64 {
+        self.ringing.as_ref().map_or(0.0, |r| r.fastest())
+    }
+
+    /// The slowest angular frequency of the ringing, rad/s (0 without ringing).
+    pub fn slowest_ringing(&self) -> f64 {
+        self.ringing
+            .as_ref()
+            .map(|r| r.slowest())
+            .filter(|w| w.is_finite())
+            .unwrap_or(0.0)
+    }
+
     /// End of the step.
     pub fn t1(&self) -> f64 {
         self.t0 + self.h

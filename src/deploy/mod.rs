@@ -110,25 +110,86 @@ pub enum LatchModel {
         stiffness: Vec<f64>,
         /// Per hinge, N·m·s/rad.
         damping: Vec<f64>,
-        /// How long the run continues after the last capture, s (`None`: the default of
-        /// [`settle_time_default`]).
+        /// How long the run continues after the last capture, s (`None`: until the latches'
+        /// motion has decayed, [`Settle::decayed`]).
         settle_time: Option<f64>,
     },
 }
 
-/// The default time the deployment continues after the last capture: ten periods of the
-/// softest latch on its panel alone (ω = √(k / (I + m l²/4))), so that the latch transients
-/// have decayed by the hand-over when c gives them any damping.
-pub fn settle_time_default(chain: &Chain, stiffness: &[f64]) -> f64 {
+/// The settling criterion's tolerance: a latch has settled once its hinge rate has stayed
+/// below this fraction of the largest hinge rate at a capture for one [`latch_period`]
+/// (its energy then below about 1e-4 of the capture's).
+pub const SETTLE_TOLERANCE: f64 = 1e-2;
+
+/// The settling's cap, in [`latch_period`]s after the last capture.
+pub const SETTLE_PERIODS: f64 = 10.0;
+
+/// The longest latch period, each latch on its panel alone: 2π √((I + m l²/4) / k_L), s.
+/// The panel's inertia about its hinge is the least the latch spring turns, so this is a
+/// lower bound of the latch mode's period when outboard panels ride along.
+pub fn latch_period(chain: &Chain, stiffness: &[f64]) -> f64 {
     chain
         .panels
         .iter()
         .zip(stiffness)
         .map(|(p, k)| {
             let j = p.inertia + 0.25 * p.mass * p.length * p.length;
-            10.0 * 2.0 * std::f64::consts::PI * (j / k).sqrt()
+            2.0 * std::f64::consts::PI * (j / k).sqrt()
         })
         .fold(0.0, f64::max)
+}
+
+/// How long a deployment with compliant latches goes on after the last capture, before the
+/// hand-over.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Settle {
+    /// For this long, s (`[deployment.latch] settle_time`).
+    For(f64),
+    /// Until the latches' motion has decayed (the default): the run ends once no captured
+    /// hinge's rate has exceeded [`SETTLE_TOLERANCE`] times the largest hinge rate at a
+    /// capture for one `window` (s), and at the latest `cap` s after the last capture (a
+    /// [`Warning::NotSettled`] then).
+    Decayed {
+        /// The quiet time asked for, s.
+        window: f64,
+        /// The longest settling, s.
+        cap: f64,
+    },
+}
+
+impl Settle {
+    /// The default for latches of stiffness `stiffness` on `chain`: decayed over one
+    /// [`latch_period`], capped at [`SETTLE_PERIODS`] of them.
+    pub fn decayed(chain: &Chain, stiffness: &[f64]) -> Self {
+        let window = latch_period(chain, stiffness);
+        Self::Decayed {
+            window,
+            cap: SETTLE_PERIODS * window,
+        }
+    }
+
+    /// The longest the run goes on after the last capture, s.
+    pub fn limit(&self) -> f64 {
+        match *self {
+            Self::For(d) => d,
+            Self::Decayed { cap, .. } => cap,
+        }
+    }
+}
+
+/// How the settling after the last capture ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Settled {
+    /// After the `settle_time` asked for.
+    AfterTime,
+    /// The latches' motion decayed below [`SETTLE_TOLERANCE`] (for one window).
+    Decayed,
+    /// At the cap, with the motion not decayed: the largest captured-hinge rate in the last
+    /// window, as a fraction of the largest rate at a capture.
+    Capped {
+        /// That fraction.
+        ratio: f64,
+    },
 }
 
 /// What a run needs besides the model.
@@ -144,8 +205,8 @@ pub struct RunSettings {
     pub tolerance: f64,
     /// The time integrator.
     pub integrator: Integrator,
-    /// With compliant latches: how long the run continues after the last capture, s.
-    pub settle_time: Option<f64>,
+    /// With compliant latches: how long the run continues after the last capture.
+    pub settle: Option<Settle>,
     /// Record the samples at k / output_rate (false: only the first, those at the latch
     /// events and the load peaks tracked at every step — what a Monte Carlo run reads;
     /// building a sample evaluates the whole model and was 58 % of such a run).
@@ -328,6 +389,8 @@ pub struct DeploymentResult {
     pub warnings: Vec<Warning>,
     /// Right-hand-side evaluations.
     pub evaluations: usize,
+    /// With compliant latches all captured: how the settling ended.
+    pub settled: Option<Settled>,
     /// Peaks of the engine's tracked load magnitudes ([`peaks`]), observed at every step
     /// (coupled model: every hinge's latch moment, then every base beam's root force and
     /// root moment, then every hinge's reaction force, every hinge's transmitted moment, and
@@ -498,15 +561,16 @@ impl Deployment {
             output_rate: self.output_rate,
             tolerance: self.tolerance,
             integrator: self.integrator,
-            settle_time: match &self.latch {
+            settle: match &self.latch {
                 LatchModel::Rigid => None,
                 LatchModel::Compliant {
                     stiffness,
                     settle_time,
                     ..
-                } => {
-                    Some(settle_time.unwrap_or_else(|| settle_time_default(&self.chain, stiffness)))
-                }
+                } => Some(
+                    settle_time
+                        .map_or_else(|| Settle::decayed(&self.chain, stiffness), Settle::For),
+                ),
             },
             record_samples: true,
         }

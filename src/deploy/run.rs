@@ -13,6 +13,7 @@ use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
 use super::Integrator;
 use super::{Capture, DeploymentResult, LatchEvent, Latching, RunSettings, RunStatus, Sample};
+use super::{Settle, Settled, SETTLE_TOLERANCE};
 use crate::warning::Warning;
 
 /// The impulses of one impact.
@@ -47,6 +48,11 @@ pub(crate) trait Engine {
     /// The hinges latch compliantly (captured, no impact).
     fn compliant(&self) -> bool {
         false
+    }
+    /// With compliant latches, the longest latch period ([`super::latch_period`]), s; 0
+    /// otherwise.
+    fn latch_period(&self) -> f64 {
+        0.0
     }
     /// For the adiabatic integrator: |Im λ| of ∂f/∂y above which an eigenvalue is the
     /// base's vibration, rad/s ([`super::adiabatic::fast_threshold`]); infinite (no ringing)
@@ -287,6 +293,17 @@ struct Run<'a, E: Engine> {
     peaks: PeakTracker,
     buf: Vec<f64>,
     warnings: Vec<Warning>,
+    /// With every hinge captured: the largest captured-hinge rate |α̇| (rad/s) at the
+    /// quarter points of the steps of the last settling window, (t, rate).
+    recent: std::collections::VecDeque<(f64, f64)>,
+    /// How the settling ended, once it has.
+    settled: Option<Settled>,
+    /// The time of the last impact or capture (release: 0), s.
+    last_event: f64,
+    /// The current step's observations resolve the motion, so that the peak tracker may
+    /// interpolate between them; false where the adiabatic stepper's ringing turns by more
+    /// than [`LOAD_PHASE`] between them (a parabola through such points is no peak).
+    resolved: bool,
 }
 
 impl<'a, E: Engine> Run<'a, E> {
@@ -317,6 +334,10 @@ impl<'a, E: Engine> Run<'a, E> {
             peaks,
             buf: vec![0.0; len],
             warnings: Vec::new(),
+            recent: std::collections::VecDeque::new(),
+            settled: None,
+            last_event: 0.0,
+            resolved: true,
         }
     }
 
@@ -332,15 +353,66 @@ impl<'a, E: Engine> Run<'a, E> {
 
     /// The run goes on: a hinge has not latched, or the captured latches are settling.
     fn active(&self) -> bool {
-        self.moving() || self.t < self.settle_end()
+        self.moving() || (self.settled.is_none() && self.t < self.settle_end())
     }
 
-    /// With compliant latches, the time the run ends after the last capture.
+    /// With compliant latches, the latest time the run ends after the last capture.
     fn settle_end(&self) -> f64 {
-        match (self.s.settle_time, self.captures.last()) {
-            (Some(d), Some(c)) => (c.time + d).min(self.s.end_time),
+        match (self.s.settle, self.captures.last()) {
+            (Some(settle), Some(c)) => (c.time + settle.limit()).min(self.s.end_time),
             _ => f64::NEG_INFINITY,
         }
+    }
+
+    /// After a step once every hinge is captured: the captured hinges' rates at the step's
+    /// quarter points (from its dense output). With [`Settle::Decayed`] the settling ends
+    /// once they have stayed below [`SETTLE_TOLERANCE`] times the largest rate at a capture
+    /// for one window since the last capture, or at its cap.
+    fn watch_settling(&mut self, step: &DenseStep) {
+        let (Some(settle), Some(last)) = (self.s.settle, self.captures.last()) else {
+            return;
+        };
+        let engine = self.sys.engine;
+        let ro = engine.positions() + engine.rate_offset();
+        let scale = self
+            .captures
+            .iter()
+            .map(|c| c.rates[c.hinge - 1].abs())
+            .fold(0.0, f64::max);
+        let mut rates = vec![0.0; self.latch_angles.len()];
+        for k in 1..=4 {
+            let t = if k == 4 {
+                self.t
+            } else {
+                step.t0 + step.h * f64::from(k) / 4.0
+            };
+            step.components(ro, t, &mut rates);
+            self.recent
+                .push_back((t, rates.iter().fold(0.0, |m: f64, r| m.max(r.abs()))));
+        }
+        let window = match settle {
+            Settle::For(d) => d,
+            Settle::Decayed { window, .. } => window,
+        };
+        while self
+            .recent
+            .front()
+            .is_some_and(|&(t, _)| t < self.t - window)
+        {
+            self.recent.pop_front();
+        }
+        let ratio = self.recent.iter().fold(0.0, |m: f64, r| m.max(r.1)) / scale;
+        let at_cap = self.t >= self.settle_end();
+        self.settled = match settle {
+            Settle::For(_) if at_cap => Some(Settled::AfterTime),
+            Settle::Decayed { window, .. }
+                if self.t - last.time >= window && ratio <= SETTLE_TOLERANCE =>
+            {
+                Some(Settled::Decayed)
+            }
+            Settle::Decayed { .. } if at_cap => Some(Settled::Capped { ratio }),
+            _ => None,
+        };
     }
 
     /// The end of the next step: the settling's end once every hinge is captured.
@@ -366,7 +438,16 @@ impl<'a, E: Engine> Run<'a, E> {
             self.t = step.t0;
             return false;
         }
-        let event = events::earliest_latch(&step, off, &self.latch_angles, &self.sys.open());
+        let open = self.sys.open();
+        let event = events::earliest_latch(&step, off, &self.latch_angles, &open).map(|e| {
+            // An ideal cable brings every hinge to its latch angle at the same instant (up to
+            // the event tolerance): the event is the root-most open hinge's, the one the
+            // cable drives, whichever crossed first by rounding.
+            match open.iter().position(|o| *o) {
+                Some(first) if self.sys.engine.ideal_cable() => Crossing { hinge: first, ..e },
+                _ => e,
+            }
+        });
         let t_limit = event.map_or(self.t, |e| e.t);
         self.sample_until(&step, t_limit);
         self.swing.scan(&step, off, t_limit);
@@ -375,6 +456,9 @@ impl<'a, E: Engine> Run<'a, E> {
                 let r = self.alpha_range();
                 self.swing.observe(self.t, &self.y[r]);
                 self.observe_loads();
+                if !self.moving() {
+                    self.watch_settling(&step);
+                }
             }
             Some(e) if self.sys.engine.compliant() => self.capture(&step, e),
             Some(e) => self.latch(&step, e),
@@ -391,6 +475,7 @@ impl<'a, E: Engine> Run<'a, E> {
         let ro = engine.positions() + engine.rate_offset();
         step.eval(e.t, &mut self.y);
         self.t = e.t;
+        self.last_event = e.t;
         self.observe_loads();
         self.peaks.break_history();
         let open = self.sys.open();
@@ -408,8 +493,13 @@ impl<'a, E: Engine> Run<'a, E> {
                 });
             }
         }
-        // The hinge sits on its latch angle (to the event tolerance): put it there exactly.
-        self.y[off + e.hinge] = self.latch_angles[e.hinge];
+        // The hinge sits on its latch angle (to the event tolerance): put it there exactly;
+        // with an ideal cable every hinge does.
+        for j in 0..self.latch_angles.len() {
+            if j == e.hinge || (all && open[j]) {
+                self.y[off + j] = self.latch_angles[j];
+            }
+        }
         self.solver.conserve(&self.sys, &mut self.y);
         self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
@@ -425,15 +515,59 @@ impl<'a, E: Engine> Run<'a, E> {
             .sys
             .engine
             .load_magnitudes(&self.y, &self.sys.free, &self.sys.captured);
-        self.peaks.observe(self.t, &m);
+        self.observe(self.t, &m);
     }
 
-    /// Samples at k / rate within (step.t0, t_limit].
+    /// Observes the load magnitudes `m` at t: with a parabola through the latest three
+    /// observations where they resolve the motion, alone otherwise.
+    fn observe(&mut self, t: f64, m: &[f64]) {
+        if !self.resolved {
+            self.peaks.break_history();
+        }
+        self.peaks.observe(t, m);
+    }
+
+    /// How long after release, an impact or a capture the tracked loads are also observed
+    /// inside the steps ([`load_times`]): the latch-up, [`LATCH_UP_PERIODS`] periods of the
+    /// slowest mode the step's ringing carries, and at least one latch period.
+    fn latch_up_window(&self, step: &DenseStep) -> f64 {
+        let slowest = step.slowest_ringing();
+        let ringing = if slowest > 0.0 {
+            LATCH_UP_PERIODS * 2.0 * std::f64::consts::PI / slowest
+        } else {
+            0.0
+        };
+        ringing.max(self.sys.engine.latch_period())
+    }
+
+    /// Samples at k / rate within (step.t0, t_limit], and the tracked loads observed between
+    /// them at [`load_times`] during a latch-up ([`Self::latch_up_window`]).
     fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
         let r = self.alpha_range();
+        let inner = if step.t0 < self.last_event + self.latch_up_window(step) {
+            load_times(step, t_limit)
+        } else {
+            Vec::new()
+        };
+        if !self.resolved {
+            // No parabola spans the unresolved step before this one.
+            self.peaks.break_history();
+        }
+        self.resolved =
+            !inner.is_empty() || step.fastest_ringing() * (t_limit - step.t0) <= LOAD_PHASE;
+        let mut inner = inner.into_iter().peekable();
         loop {
             let tk = self.next_k as f64 / self.s.output_rate;
-            if tk > t_limit || tk > self.s.end_time {
+            let due = tk <= t_limit && tk <= self.s.end_time;
+            while let Some(ti) = inner.next_if(|&ti| !due || ti < tk) {
+                step.eval(ti, &mut self.buf);
+                let m =
+                    self.sys
+                        .engine
+                        .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
+                self.observe(ti, &m);
+            }
+            if !due {
                 break;
             }
             step.eval(tk, &mut self.buf);
@@ -442,7 +576,7 @@ impl<'a, E: Engine> Run<'a, E> {
                 .sys
                 .engine
                 .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
-            self.peaks.observe(tk, &m);
+            self.observe(tk, &m);
             if self.s.record_samples {
                 self.samples.push(self.sys.engine.sample(
                     tk,
@@ -463,6 +597,7 @@ impl<'a, E: Engine> Run<'a, E> {
         let np = engine.positions();
         step.eval(e.t, &mut self.y);
         self.t = e.t;
+        self.last_event = e.t;
         let cable = engine.ideal_cable();
         let all = cable || self.s.latching == Latching::Simultaneous;
         let mut free_after = self.sys.free.clone();
@@ -569,6 +704,13 @@ impl<'a, E: Engine> Run<'a, E> {
             RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
             RunStatus::AllLatched | RunStatus::EndTime => {}
         }
+        if let Some(Settled::Capped { ratio }) = self.settled {
+            warnings.push(Warning::NotSettled {
+                t,
+                ratio,
+                tolerance: SETTLE_TOLERANCE,
+            });
+        }
         if !all_latched {
             warnings.push(Warning::NotLatched {
                 t,
@@ -591,9 +733,34 @@ impl<'a, E: Engine> Run<'a, E> {
             swing_back,
             warnings,
             evaluations: self.solver.evaluations(),
+            settled: self.settled,
             load_peaks: self.peaks.peaks().to_vec(),
         }
     }
+}
+
+/// The latch-up's length in periods of the slowest carried ringing mode.
+const LATCH_UP_PERIODS: f64 = 4.0;
+
+/// Where the adiabatic stepper's fastest carried ringing mode turns by more than this phase
+/// (rad) within a step, the loads are observed inside the step too.
+const LOAD_PHASE: f64 = 0.125;
+
+/// The times inside (step.t0, t_limit) at which the tracked loads are observed besides the
+/// step's end: none where the dense output is the integrator's polynomial (the steps resolve
+/// the motion), and for the adiabatic stepper's ringing, which its steps do not resolve, a
+/// spacing of [`LOAD_PHASE`] / ω of its fastest carried mode, so that the peak tracker's
+/// parabola finds a peak of that mode to ~0.25 (ωδ)³ ≈ 5e-4 relative.
+fn load_times(step: &DenseStep, t_limit: f64) -> Vec<f64> {
+    let span = t_limit - step.t0;
+    let turns = step.fastest_ringing() * span / LOAD_PHASE;
+    if turns.is_nan() || turns <= 1.0 {
+        return Vec::new();
+    }
+    let n = turns.ceil().min(1e4) as usize;
+    (1..n)
+        .map(|k| step.t0 + span * k as f64 / n as f64)
+        .collect()
 }
 
 /// Runs `engine` from release until every hinge has latched or the end time (at most

@@ -4,7 +4,9 @@ use super::plot::{line_chart, Series};
 use super::{num, OutputDir, OutputError};
 use crate::deploy::base::BaseKind;
 use crate::deploy::coupled::{Coupled, Synchronisation};
-use crate::deploy::{BodySample, Deployment, DeploymentResult, Latching};
+use crate::deploy::{
+    BodySample, Deployment, DeploymentResult, Latching, Settled, SETTLE_TOLERANCE,
+};
 use crate::structure::HubMotion;
 use serde_json::{json, Value};
 use std::fmt::Write;
@@ -192,6 +194,7 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "captures": r.captures.iter().map(|k| json!({"time": k.time, "hinge": k.hinge, "rates": k.rates})).collect::<Vec<_>>(),
         "all_latched": r.all_latched,
         "final_time": r.final_time,
+        "settled": settled_json(r.settled),
         "rhs_evaluations": r.evaluations,
         "unlatched": r.unlatched.iter().map(|(h, a)| json!({"hinge": h, "angle": a})).collect::<Vec<_>>(),
         "swing_back": r.swing_back.iter().map(|s| json!({"hinge": s.hinge, "first_time": s.first_time, "min_angle": s.min_angle})).collect::<Vec<_>>(),
@@ -281,24 +284,7 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
             rates.join(", ")
         );
     }
-    let verdict = if r.all_latched {
-        "all hinges latched"
-    } else {
-        "NOT all hinges latched"
-    };
-    match r.captures.last() {
-        // Compliant latches: the run goes on after the last capture while they settle.
-        Some(last) if r.all_latched => {
-            let _ = writeln!(
-                s,
-                "\nall hinges captured (the last at t = {:.9} s); the latches settled until t = {:.9} s",
-                last.time, r.final_time
-            );
-        }
-        _ => {
-            let _ = writeln!(s, "\n{verdict} at t = {:.9} s", r.final_time);
-        }
-    }
+    let _ = writeln!(s, "\n{}", ending(r));
     if c.base.hub_motion == HubMotion::Free {
         let b = final_body(r);
         // Each quantity's components within rounding of its largest over the run read 0.
@@ -474,4 +460,49 @@ pub fn write_deploy(
         true,
     )?;
     Ok(())
+}
+
+/// How the compliant latches' settling ended, in words.
+fn settled_text(s: Option<Settled>) -> String {
+    let tol = 100.0 * SETTLE_TOLERANCE;
+    match s {
+        Some(Settled::AfterTime) => "the settle_time asked for".to_string(),
+        Some(Settled::Decayed) => format!(
+            "the latches settled (every captured hinge's rate below {tol} % of the largest at a \
+             capture for one latch period)"
+        ),
+        Some(Settled::Capped { ratio }) => format!(
+            "the settling's cap, the latches NOT settled (rates still {:.2} % of the largest at a \
+             capture; settled means below {tol} %)",
+            100.0 * ratio
+        ),
+        None => "the end time".to_string(),
+    }
+}
+
+/// How the settling ended, for events.json.
+fn settled_json(s: Option<Settled>) -> Value {
+    match s {
+        Some(Settled::AfterTime) => json!({"by": "settle_time"}),
+        Some(Settled::Decayed) => json!({"by": "decayed", "tolerance": SETTLE_TOLERANCE}),
+        Some(Settled::Capped { ratio }) => {
+            json!({"by": "cap", "tolerance": SETTLE_TOLERANCE, "ratio": ratio})
+        }
+        None => Value::Null,
+    }
+}
+
+/// How the run ended, in one line.
+fn ending(r: &DeploymentResult) -> String {
+    match r.captures.last() {
+        // Compliant latches: the run goes on after the last capture while they settle.
+        Some(last) if r.all_latched => format!(
+            "all hinges captured (the last at t = {:.9} s); the deployment went on until t = {:.9} s: {}",
+            last.time,
+            r.final_time,
+            settled_text(r.settled)
+        ),
+        _ if r.all_latched => format!("all hinges latched at t = {:.9} s", r.final_time),
+        _ => format!("NOT all hinges latched at t = {:.9} s", r.final_time),
+    }
 }

@@ -81,6 +81,78 @@ fn one_panel_capture_matches_the_damped_oscillator() {
     assert!(r.all_latched);
 }
 
+/// The default settling (no `settle_time`) ends once the hinge rate has stayed below 1 % of
+/// the capture rate for one latch period W = 2π √(J / k_L), J = I + m l²/4 = 40/3 kg·m²:
+/// the end time against the closed-form damped oscillator's (the first t with
+/// max_{[t − W, t]} |ẋ| ≤ 0.01 ω₀), to 2 % of W (the run checks at its steps' quarter
+/// points). With light damping the cap, ten periods after the capture, ends it, with a
+/// warning that gives the rate left.
+#[test]
+fn the_default_settling_ends_when_the_latch_has_decayed_or_at_its_cap() {
+    use flexcraft::deploy::Settled;
+    let (kl, j) = (4000.0_f64, 40.0 / 3.0);
+    let w = 2.0 * std::f64::consts::PI * (j / kl).sqrt();
+    for (cl, decays) in [(60.0, true), (6.0, false)] {
+        let src = one_panel(&format!(
+            "[deployment.latch]\nmodel = \"compliant\"\nstiffness = {kl:?}\ndamping = {cl:?}\n"
+        ));
+        let sc = Scenario::from_toml_str(&src, "one.toml").unwrap();
+        let (c, r) = simulate_coupled(&sc.structure, sc.deployment.as_ref().unwrap()).unwrap();
+        let h = &c.chain.hinges[0];
+        let (k, a_ref, a_l) = (h.stiffness, h.reference_angle, h.latch_angle);
+        let cap = &r.captures[0];
+        let w0 = cap.rates[0];
+        // ẋ(t) of J ẍ + c_L ẋ + (k + k_L) x = 0, x(0) = α_L − α_eq, ẋ(0) = ω₀.
+        let a_eq = (k * a_ref + kl * a_l) / (k + kl);
+        let wn = ((k + kl) / j).sqrt();
+        let zeta = cl / (2.0 * (j * (k + kl)).sqrt());
+        let wd = wn * (1.0 - zeta * zeta).sqrt();
+        let (x0, v0) = (a_l - a_eq, w0);
+        let b = (v0 + zeta * wn * x0) / wd;
+        let rate = |t: f64| {
+            let e = (-zeta * wn * t).exp();
+            let (s, co) = (wd * t).sin_cos();
+            -zeta * wn * e * (x0 * co + b * s) + e * wd * (b * co - x0 * s)
+        };
+        // The last time |ẋ| exceeds 1 %, on a grid of W/2000 over the cap.
+        let dt = w / 2000.0;
+        let last_loud = (0..20_000)
+            .map(|i| f64::from(i) * dt)
+            .filter(|&t| rate(t).abs() > 0.01 * w0)
+            .fold(0.0, f64::max);
+        let settle = r.final_time - cap.time;
+        if decays {
+            let expected = last_loud + w;
+            assert!(expected < 10.0 * w, "{expected} s: not within the cap");
+            assert!(
+                (settle - expected).abs() < 0.02 * w,
+                "settled {settle} s after the capture, closed form {expected} s"
+            );
+            assert_eq!(r.settled, Some(Settled::Decayed));
+            assert!(r.warnings.is_empty(), "{:?}", r.warnings);
+        } else {
+            assert!(last_loud + w > 10.0 * w);
+            assert!((settle - 10.0 * w).abs() < 1e-9, "{settle} vs {}", 10.0 * w);
+            let Some(Settled::Capped { ratio }) = r.settled else {
+                panic!("{:?}", r.settled);
+            };
+            // The largest |ẋ| over the last period, from the closed form.
+            let loudest = (0..=2000)
+                .map(|i| rate(10.0 * w - f64::from(i) * dt).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                (ratio - loudest / w0).abs() < 2e-3 * ratio,
+                "{ratio} vs {}",
+                loudest / w0
+            );
+            assert!(r
+                .warnings
+                .iter()
+                .any(|x| x.to_string().contains("had not settled")));
+        }
+    }
+}
+
 /// As the latch stiffness grows at a fixed damping ratio (c_L ∝ √k_L), the rate some latch
 /// periods after capture tends to the plastic impact's post-impact rate (zero for one panel
 /// on a held hub) and the energy the latch takes to the impact's loss; the hinge angle tends
