@@ -516,6 +516,10 @@ pub fn slow_manifold(sys: &dyn OdeSystem, y: &[f64], threshold: f64) -> Option<(
     Some((project(sys, y, &modes), count))
 }
 
+/// The share of the largest mode's acceleration amplitude below which a carried mode does
+/// not set the pace of the load sampling ([`RingingStep::fastest`]).
+const LOADING_MODE: f64 = 1e-3;
+
 /// The ringing over one slow step [t0, t1]: δ(t) = Re Σ_j a_j e^{θ_j(t)} v_j(t), with
 /// θ_j(t) = ∫_{t0}^t λ_j, λ_j the polynomial through its values at this step's ends and up to
 /// two earlier ones (a cubic once four step ends exist, local error O(h⁵); linear and
@@ -545,12 +549,27 @@ impl RingingStep {
         })
     }
 
-    /// The fastest carried mode's angular frequency at the step's end, |Im λ|, rad/s.
+    /// The fastest carried mode's angular frequency at the step's end, |Im λ| (rad/s), among
+    /// the modes that load the structure: whose acceleration amplitude ω_j |c_j| ‖v_j‖ is
+    /// at least [`LOADING_MODE`] of the largest. A faster mode carried with less is missed
+    /// by a load sampling at this mode's pace by no more than that share.
     pub fn fastest(&self) -> f64 {
-        self.lam
+        let weight: Vec<(f64, f64)> = self
+            .lam
             .iter()
-            .filter_map(|l| l.last())
-            .fold(0.0, |m: f64, l| m.max(l.im.abs()))
+            .zip(&self.a)
+            .zip(&self.v)
+            .filter_map(|((l, a), v)| {
+                let w = l.last()?.im.abs();
+                let norm = v[1].iter().map(|x| x.norm_sqr()).sum::<f64>().sqrt();
+                Some((w, w * a.norm() * norm))
+            })
+            .collect();
+        let top = weight.iter().fold(0.0, |m: f64, x| m.max(x.1));
+        weight
+            .iter()
+            .filter(|x| x.1 >= LOADING_MODE * top)
+            .fold(0.0, |m: f64, x| m.max(x.0))
     }
 
     /// The slowest carried mode's angular frequency at the step's end, |Im λ|, rad/s
