@@ -67,14 +67,18 @@ pub enum Warning {
     /// Rigid latches on an elastic base: the latch outcome with half of the kept base modes
     /// (the latch with the largest change of the base impulse).
     RigidLatchTruncation(crate::deploy::HalfModes),
-    /// Compliant latches still moving when the settling's cap ended the deployment.
+    /// Compliant latches still moving when the settling's cap, or the deployment's end time,
+    /// ended the deployment.
     NotSettled {
-        /// The end of the settling, s.
+        /// The end of the deployment, s.
         t: f64,
-        /// The largest captured-hinge rate in the last window over the largest at a capture.
-        ratio: f64,
-        /// The tolerance asked for.
+        /// The largest captured-hinge rate in the last window over the largest at a capture
+        /// (None with a `settle_time`, which is not watched).
+        ratio: Option<f64>,
+        /// The settling's tolerance on that fraction.
         tolerance: f64,
+        /// `end_time` ended it, not the settling's cap.
+        by_end_time: bool,
     },
     /// The array locked away from the straight wing; the hand-over uses the straight wing.
     AngleMismatch {
@@ -150,15 +154,8 @@ impl fmt::Display for Warning {
                 t,
                 ratio,
                 tolerance,
-            } => write!(
-                f,
-                "the latches had not settled when the deployment handed over at t = {t} s: the \
-                 hinge rates were still {:.2} % of the largest rate at a capture (settled means \
-                 below {:.2} %); the latch springs' remaining motion is not in the response. Add \
-                 latch damping or set [deployment.latch] settle_time",
-                100.0 * ratio,
-                100.0 * tolerance
-            ),
+                by_end_time,
+            } => f.write_str(&not_settled(*t, *ratio, *tolerance, *by_end_time)),
             Self::LocksBent { t, hinge, rad } => write!(
                 f,
                 "LATCHING = \"simultaneous\" WITHOUT A CABLE LOCKS THE ARRAY BENT: at t = {t} s \
@@ -197,7 +194,7 @@ impl fmt::Display for Warning {
             Self::AngleMismatch { rad } => write!(
                 f,
                 "the array locked away from the straight wing (largest hinge-angle mismatch \
-                 {rad:.6} rad): the hand-over uses the straight wing"
+                 {rad:.3e} rad): the hand-over uses the straight wing"
             ),
             Self::LargeDeflection {
                 label,
@@ -214,5 +211,29 @@ impl fmt::Display for Warning {
             ),
             Self::HandoverNote(note) => f.write_str(note),
         }
+    }
+}
+
+/// [`Warning::NotSettled`]'s text.
+fn not_settled(t: f64, ratio: Option<f64>, tolerance: f64, by_end_time: bool) -> String {
+    let left = ratio.map_or(String::new(), |r| {
+        format!(
+            ": the hinge rates were still {:.2} % of the largest rate at a capture (settled \
+             means below {:.2} %)",
+            100.0 * r,
+            100.0 * tolerance
+        )
+    });
+    if by_end_time {
+        format!(
+            "the deployment's end_time, t = {t} s, came before the latches had settled{left}; \
+             the hand-over starts from there. Raise [deployment] end_time"
+        )
+    } else {
+        format!(
+            "the latches had not settled when the deployment handed over at t = {t} s{left}; \
+             the latch springs' remaining motion is not in the response. Add latch damping or \
+             set [deployment.latch] settle_time"
+        )
     }
 }

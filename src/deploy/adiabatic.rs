@@ -551,7 +551,7 @@ impl RingingStep {
 
     /// The fastest carried mode's angular frequency at the step's end, |Im λ| (rad/s), among
     /// the modes that load the structure: whose acceleration amplitude ω_j |c_j| ‖v_j‖ is
-    /// at least [`LOADING_MODE`] of the largest. A faster mode carried with less is missed
+    /// at least `LOADING_MODE` (1e-3) of the largest. A faster mode carried with less is missed
     /// by a load sampling at this mode's pace by no more than that share.
     pub fn fastest(&self) -> f64 {
         let weight: Vec<(f64, f64)> = self
@@ -566,6 +566,9 @@ impl RingingStep {
             })
             .collect();
         let top = weight.iter().fold(0.0, |m: f64, x| m.max(x.1));
+        if top.is_nan() || top <= 0.0 {
+            return 0.0;
+        }
         weight
             .iter()
             .filter(|x| x.1 >= LOADING_MODE * top)

@@ -254,7 +254,11 @@ impl Coupled {
 
     /// The cable's loop matrix C ((N − 1) × N).
     fn cable_rows(&self) -> Vec<Vec<f64>> {
-        let n = self.panels();
+        Self::cable_law(self.panels())
+    }
+
+    /// The cable law's rows for `n` hinges, C α̇ = 0: α̇₂ = 2 α̇₁, α̇_{k+1} = α̇_k (k ≥ 2).
+    pub(crate) fn cable_law(n: usize) -> Vec<Vec<f64>> {
         (1..n)
             .map(|k| {
                 let mut r = vec![0.0; n];
@@ -1717,7 +1721,7 @@ impl Coupled {
             settle: self
                 .latch
                 .as_ref()
-                .map(|l| super::Settle::decayed(&self.chain, &l.stiffness)),
+                .map(|l| super::Settle::decayed(&self.chain, &l.stiffness, self.sync)),
         };
         let r = super::run::run(self, &settings, super::MAX_STEPS);
         let latches = r

@@ -277,9 +277,9 @@ impl Engine for Coupled {
         self.latch.is_some()
     }
     fn latch_period(&self) -> f64 {
-        self.latch
-            .as_ref()
-            .map_or(0.0, |l| super::latch_period(&self.chain, &l.stiffness))
+        self.latch.as_ref().map_or(0.0, |l| {
+            super::latch_period(&self.chain, &l.stiffness, self.sync)
+        })
     }
     fn fast_threshold(&self) -> f64 {
         let lowest = self.base.omega[..self.modes()]

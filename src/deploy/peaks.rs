@@ -2,7 +2,9 @@
 //!
 //! A latch-up load peaks within a fraction of the latch's period, which the output rate
 //! need not resolve, so the run observes every tracked magnitude at every accepted step's
-//! end (the integrator resolves the motion there) and at every sample and event. Where the
+//! end (the explicit and implicit integrators resolve the motion there; the adiabatic one,
+//! whose steps do not resolve the ringing, adds points inside its steps during a latch-up,
+//! `super::run`) and at every sample and event. Where the
 //! three latest observations of a magnitude rise and fall, the peak between them is the
 //! vertex of the parabola through them (error O(h³) for a smooth magnitude against O(h²)
 //! for the largest observation alone). A latch or a capture changes the loads abruptly; the

@@ -49,7 +49,7 @@ pub(crate) trait Engine {
     fn compliant(&self) -> bool {
         false
     }
-    /// With compliant latches, the longest latch period ([`super::latch_period`]), s; 0
+    /// With compliant latches, the latch mode's period ([`super::latch_period`]), s; 0
     /// otherwise.
     fn latch_period(&self) -> f64 {
         0.0
@@ -372,13 +372,33 @@ impl<'a, E: Engine> Run<'a, E> {
         let (Some(settle), Some(last)) = (self.s.settle, self.captures.last()) else {
             return;
         };
+        let last_time = last.time;
+        let ratio = match settle {
+            Settle::For(_) => None,
+            Settle::Decayed { window, .. } => Some(self.rates_left(step, window)),
+        };
+        let decayed = match settle {
+            Settle::Decayed { window, .. } => {
+                self.t - last_time >= window && ratio.is_some_and(|r| r <= SETTLE_TOLERANCE)
+            }
+            Settle::For(_) => false,
+        };
+        self.settled = if decayed {
+            Some(Settled::Decayed)
+        } else if self.t >= last_time + settle.limit() {
+            Some(ratio.map_or(Settled::AfterTime, |ratio| Settled::Capped { ratio }))
+        } else if self.t >= self.s.end_time {
+            Some(Settled::EndTime { ratio })
+        } else {
+            None
+        };
+    }
+
+    /// The captured hinges' largest |α̇| over the last `window` (s), read at the quarter
+    /// points of every step since the last capture, over the largest hinge rate at a capture.
+    fn rates_left(&mut self, step: &DenseStep, window: f64) -> f64 {
         let engine = self.sys.engine;
         let ro = engine.positions() + engine.rate_offset();
-        let scale = self
-            .captures
-            .iter()
-            .map(|c| c.rates[c.hinge - 1].abs())
-            .fold(0.0, f64::max);
         let mut rates = vec![0.0; self.latch_angles.len()];
         for k in 1..=4 {
             let t = if k == 4 {
@@ -387,13 +407,13 @@ impl<'a, E: Engine> Run<'a, E> {
                 step.t0 + step.h * f64::from(k) / 4.0
             };
             step.components(ro, t, &mut rates);
-            self.recent
-                .push_back((t, rates.iter().fold(0.0, |m: f64, r| m.max(r.abs()))));
+            let loudest = rates.iter().fold(0.0, |m: f64, r| m.max(r.abs()));
+            // A decreasing deque: its front is the window's largest.
+            while self.recent.back().is_some_and(|&(_, v)| v <= loudest) {
+                self.recent.pop_back();
+            }
+            self.recent.push_back((t, loudest));
         }
-        let window = match settle {
-            Settle::For(d) => d,
-            Settle::Decayed { window, .. } => window,
-        };
         while self
             .recent
             .front()
@@ -401,18 +421,19 @@ impl<'a, E: Engine> Run<'a, E> {
         {
             self.recent.pop_front();
         }
-        let ratio = self.recent.iter().fold(0.0, |m: f64, r| m.max(r.1)) / scale;
-        let at_cap = self.t >= self.settle_end();
-        self.settled = match settle {
-            Settle::For(_) if at_cap => Some(Settled::AfterTime),
-            Settle::Decayed { window, .. }
-                if self.t - last.time >= window && ratio <= SETTLE_TOLERANCE =>
-            {
-                Some(Settled::Decayed)
-            }
-            Settle::Decayed { .. } if at_cap => Some(Settled::Capped { ratio }),
-            _ => None,
-        };
+        let largest = self.recent.front().map_or(0.0, |r| r.1);
+        let scale = self
+            .captures
+            .iter()
+            .map(|c| c.rates[c.hinge - 1].abs())
+            .fold(0.0, f64::max);
+        if scale > 0.0 {
+            largest / scale
+        } else if largest > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        }
     }
 
     /// The end of the next step: the settling's end once every hinge is captured.
@@ -555,8 +576,11 @@ impl<'a, E: Engine> Run<'a, E> {
             // No parabola spans the unresolved step before this one.
             self.peaks.break_history();
         }
+        // Resolved: the observations (inner points and the end) no farther apart than
+        // LOAD_PHASE / ω (the spacing's rounding aside).
+        let gaps = inner.len() as f64 + 1.0;
         self.resolved =
-            !inner.is_empty() || step.fastest_ringing() * (t_limit - step.t0) <= LOAD_PHASE;
+            step.fastest_ringing() * (t_limit - step.t0) <= LOAD_PHASE * gaps * (1.0 + 1e-9);
         let mut inner = inner.into_iter().peekable();
         loop {
             let tk = self.next_k as f64 / self.s.output_rate;
@@ -706,12 +730,25 @@ impl<'a, E: Engine> Run<'a, E> {
             RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
             RunStatus::AllLatched | RunStatus::EndTime => {}
         }
-        if let Some(Settled::Capped { ratio }) = self.settled {
-            warnings.push(Warning::NotSettled {
+        // All captured, but no step after the last capture (it fell on end_time).
+        let settled = self.settled.or_else(|| {
+            (all_latched && self.s.settle.is_some() && status == RunStatus::EndTime)
+                .then_some(Settled::EndTime { ratio: None })
+        });
+        match settled {
+            Some(Settled::Capped { ratio }) => warnings.push(Warning::NotSettled {
+                t,
+                ratio: Some(ratio),
+                tolerance: SETTLE_TOLERANCE,
+                by_end_time: false,
+            }),
+            Some(Settled::EndTime { ratio }) => warnings.push(Warning::NotSettled {
                 t,
                 ratio,
                 tolerance: SETTLE_TOLERANCE,
-            });
+                by_end_time: true,
+            }),
+            _ => {}
         }
         if !all_latched {
             warnings.push(Warning::NotLatched {
@@ -735,11 +772,14 @@ impl<'a, E: Engine> Run<'a, E> {
             swing_back,
             warnings,
             evaluations: self.solver.evaluations(),
-            settled: self.settled,
+            settled,
             load_peaks: self.peaks.peaks().to_vec(),
         }
     }
 }
+
+/// The most points [`load_times`] gives one step (past it the step is not resolved).
+const MAX_LOAD_TIMES: f64 = 1e4;
 
 /// The latch-up's length in periods of the slowest carried ringing mode.
 const LATCH_UP_PERIODS: f64 = 4.0;
@@ -759,7 +799,7 @@ fn load_times(step: &DenseStep, t_limit: f64) -> Vec<f64> {
     if turns.is_nan() || turns <= 1.0 {
         return Vec::new();
     }
-    let n = turns.ceil().min(1e4) as usize;
+    let n = turns.ceil().min(MAX_LOAD_TIMES) as usize;
     (1..n)
         .map(|k| step.t0 + span * k as f64 / n as f64)
         .collect()

@@ -476,7 +476,10 @@ fn settled_text(s: Option<Settled>) -> String {
              capture; settled means below {tol} %)",
             100.0 * ratio
         ),
-        None => "the end time".to_string(),
+        Some(Settled::EndTime { .. }) => {
+            "the deployment's end_time, before the latches had settled".to_string()
+        }
+        None => "the run stopped (see the warnings)".to_string(),
     }
 }
 
@@ -487,6 +490,9 @@ fn settled_json(s: Option<Settled>) -> Value {
         Some(Settled::Decayed) => json!({"by": "decayed", "tolerance": SETTLE_TOLERANCE}),
         Some(Settled::Capped { ratio }) => {
             json!({"by": "cap", "tolerance": SETTLE_TOLERANCE, "ratio": ratio})
+        }
+        Some(Settled::EndTime { ratio }) => {
+            json!({"by": "end_time", "tolerance": SETTLE_TOLERANCE, "ratio": ratio})
         }
         None => Value::Null,
     }

@@ -70,6 +70,19 @@ fn seed_with_the_ideal_cable_matches_the_explicit_reference_in_few_steps() {
     let d = latch_differences(&adiabatic, &reference);
     assert!(d[0] <= 2e-9, "latch time {d:?}");
     assert!(d[1] <= 3e-7 && d[2] <= 3e-7 && d[3] <= 3e-7, "{d:?}");
+    // Before the latch the adiabatic run reads the loads at its step ends only, which do not
+    // resolve the ringing: its peaks may come out low, never high (a parabola through such
+    // points put 11.2 N at the mast root against the resolved 7.96 N).
+    for (p, q) in adiabatic.load_peaks.iter().zip(&reference.load_peaks) {
+        assert!(
+            p.0 <= q.0 * (1.0 + 1e-6),
+            "peak {} at {} s, reference {} at {} s",
+            p.0,
+            p.1,
+            q.0,
+            q.1
+        );
+    }
     assert!(
         adiabatic.evaluations * 50 < reference.evaluations,
         "{} evaluations against {}",
@@ -114,6 +127,12 @@ fn independent_hinges_latch_in_turn_as_in_the_explicit_reference() {
 #[test]
 fn compliant_latches_capture_as_in_the_explicit_reference() {
     let sc = scenario("seed_compliant.toml", |s| s);
+    let c = sc
+        .deployment
+        .as_ref()
+        .unwrap()
+        .coupled(&sc.structure)
+        .unwrap();
     let reference = run(&sc, 6, Integrator::Explicit, 1e-10);
     let adiabatic = run(&sc, 6, Integrator::Adiabatic, 1e-8);
     let (a, b) = (&adiabatic.captures, &reference.captures);
@@ -135,6 +154,19 @@ fn compliant_latches_capture_as_in_the_explicit_reference() {
         );
         assert!((p.1 - q.1).abs() <= 1e-5, "peak at {} s vs {} s", p.1, q.1);
     }
+    // The latches settle (rates below 1 % of the capture's for one latch period) at the same
+    // time in both runs, to 2 % of that period (the runs read the rates at their own steps).
+    let w = flexcraft::deploy::latch_period(&c.chain, &c.latch.as_ref().unwrap().stiffness, c.sync);
+    assert!(w > 0.3 && w < 0.5, "latch period {w}");
+    for r in [&adiabatic, &reference] {
+        assert_eq!(r.settled, Some(flexcraft::deploy::Settled::Decayed));
+    }
+    assert!(
+        (adiabatic.final_time - reference.final_time).abs() < 0.02 * w,
+        "settled at {} s and {} s",
+        adiabatic.final_time,
+        reference.final_time
+    );
     assert!(
         adiabatic.evaluations * 10 < reference.evaluations,
         "{} evaluations against {}",

@@ -78,20 +78,22 @@ fn one_panel_capture_matches_the_damped_oscillator() {
     assert!(checked > 100, "{checked} samples after the capture");
     // The run settles for settle_time after the capture.
     assert!((r.final_time - (cap.time + 5.0)).abs() < 1e-9);
+    assert_eq!(r.settled, Some(flexcraft::deploy::Settled::AfterTime));
     assert!(r.all_latched);
 }
 
 /// The default settling (no `settle_time`) ends once the hinge rate has stayed below 1 % of
-/// the capture rate for one latch period W = 2π √(J / k_L), J = I + m l²/4 = 40/3 kg·m²:
-/// the end time against the closed-form damped oscillator's (the first t with
-/// max_{[t − W, t]} |ẋ| ≤ 0.01 ω₀), to 2 % of W (the run checks at its steps' quarter
-/// points). With light damping the cap, ten periods after the capture, ends it, with a
-/// warning that gives the rate left.
+/// the capture rate for one latch period W = 2π √(J / (k + k_L)), J = I + m l²/4 =
+/// 40/3 kg·m², k = 3 N·m/rad the hinge spring: the end time against the closed-form damped
+/// oscillator's (the first t with max_{[t − W, t]} |ẋ| ≤ 0.01 ω₀), to 2 % of W (the run
+/// checks at its steps' quarter points). With light damping the cap, ten periods after the
+/// capture, ends it, with a warning that gives the rate left; an end_time before either ends
+/// it with a warning that says so.
 #[test]
 fn the_default_settling_ends_when_the_latch_has_decayed_or_at_its_cap() {
     use flexcraft::deploy::Settled;
     let (kl, j) = (4000.0_f64, 40.0 / 3.0);
-    let w = 2.0 * std::f64::consts::PI * (j / kl).sqrt();
+    let w = 2.0 * std::f64::consts::PI * (j / (kl + 3.0)).sqrt();
     for (cl, decays) in [(60.0, true), (6.0, false)] {
         let src = one_panel(&format!(
             "[deployment.latch]\nmodel = \"compliant\"\nstiffness = {kl:?}\ndamping = {cl:?}\n"
@@ -151,6 +153,22 @@ fn the_default_settling_ends_when_the_latch_has_decayed_or_at_its_cap() {
                 .any(|x| x.to_string().contains("had not settled")));
         }
     }
+    // end_time 1 s after the capture: neither decayed nor capped.
+    let src = one_panel(
+        "[deployment.latch]\nmodel = \"compliant\"\nstiffness = 4000.0\ndamping = 60.0\n",
+    );
+    let sc = Scenario::from_toml_str(&src, "one.toml").unwrap();
+    let (_, r) = simulate_coupled(&sc.structure, sc.deployment.as_ref().unwrap()).unwrap();
+    let t_cut = r.captures[0].time + 1.0;
+    let src = src.replace("end_time = 20.0", &format!("end_time = {t_cut:?}"));
+    let sc = Scenario::from_toml_str(&src, "one.toml").unwrap();
+    let (_, r) = simulate_coupled(&sc.structure, sc.deployment.as_ref().unwrap()).unwrap();
+    assert!(r.all_latched && (r.final_time - t_cut).abs() < 1e-9);
+    assert!(matches!(r.settled, Some(Settled::EndTime { ratio: Some(x) }) if x > 0.01));
+    assert!(r
+        .warnings
+        .iter()
+        .any(|x| x.to_string().contains("end_time")));
 }
 
 /// As the latch stiffness grows at a fixed damping ratio (c_L ∝ √k_L), the rate some latch
@@ -515,4 +533,33 @@ fn compliant_latches_agree_with_the_maximal_coordinate_formulation() {
         "latch moments: {worst_moment:.1e} of the peak"
     );
     assert!(worst_alpha <= 1e-8, "hinge angles: {worst_alpha:.1e} rad");
+}
+
+/// The latch period that paces the settling, against closed forms at the straight latch
+/// configuration, base held. seed_compliant's three equal panels (m = 150 kg, l = 5 m) tied
+/// by the ideal cable (α̇ = (1, 2, 2) ṡ): the panels turn by ∓ṡ in turn and their centres
+/// move at 2.5 ṡ each, so T = ½ (3 m (l/2)² + 3 m l²/12) ṡ² = ½ m l² ṡ² against
+/// V = ½ (1 + 4 + 4)(k + k_L) s²: ω² = 9 (k + k_L) / (m l²). One panel alone:
+/// ω² = (k + k_L) / (m l²/3).
+#[test]
+fn the_latch_period_is_the_captured_arrays_slowest_mode() {
+    use flexcraft::deploy::coupled::Synchronisation;
+    use flexcraft::deploy::latch_period;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed_compliant.toml");
+    let sc = Scenario::from_toml_str(&std::fs::read_to_string(path).unwrap(), path).unwrap();
+    let d = sc.deployment.as_ref().unwrap();
+    let c = d.coupled(&sc.structure).unwrap();
+    let kl = &c.latch.as_ref().unwrap().stiffness;
+    let (m, l) = (c.chain.panels[0].mass, c.chain.panels[0].length);
+    let k = c.chain.hinges[0].stiffness;
+    assert!((m - 150.0).abs() < 1e-9 && (l - 5.0).abs() < 1e-12);
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let cable = two_pi * (m * l * l / (9.0 * (k + kl[0]))).sqrt();
+    let w = latch_period(&c.chain, kl, Synchronisation::IdealCable);
+    assert!((w - cable).abs() < 1e-12 * cable, "{w} vs {cable}");
+    // Without the cable the slowest mode is that of the whole array on its three latches:
+    // slower than one panel alone on its latch.
+    let alone = two_pi * (m * l * l / 3.0 / (k + kl[0])).sqrt();
+    let free = latch_period(&c.chain, kl, Synchronisation::None);
+    assert!(free > 1.5 * alone, "{free} vs one panel's {alone}");
 }
