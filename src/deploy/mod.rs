@@ -122,7 +122,7 @@ pub enum LatchModel {
 pub const SETTLE_TOLERANCE: f64 = 1e-2;
 
 /// The settling's cap, in [`latch_period`]s after the last capture.
-pub const SETTLE_PERIODS: f64 = 10.0;
+pub const SETTLE_PERIODS: f64 = 100.0;
 
 /// The latch mode's period, s: the slowest free vibration of the captured array about its
 /// latch angles with the base held, M(α_L) ẍ + K x = 0, M the chain's mass matrix (hinge

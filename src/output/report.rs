@@ -818,6 +818,11 @@ fn handover_table(s: &Scenario, sim: &Simulation, r: &crate::simulation::Respons
             (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
         ),
         (
+            "latch springs' energy, not carried [J]",
+            "/handover/latch_energy",
+            h.latch_energy,
+        ),
+        (
             "share of the hand-over energy in the kept modes",
             "/handover/captured_energy_fraction",
             r.modal.captured_energy_fraction,

@@ -52,6 +52,7 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             "elastic_energy_before": h.elastic_energy_before,
             "elastic_energy_after": h.elastic_energy_after,
             "projection_residual": (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
+            "latch_energy": h.latch_energy,
         },
         "response": {
             "duration": st.duration,
@@ -315,6 +316,14 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
         before - after,
         100.0 * (before - after) / before.max(1e-300)
     );
+    if h.latch_energy > 0.0 {
+        let _ = writeln!(
+            o,
+            "  latch springs' energy {:.6e} J ({:.2e} of the total): not carried, the deployed wing has no latch spring",
+            h.latch_energy,
+            h.latch_energy / before.max(1e-300)
+        );
+    }
     let _ = writeln!(
         o,
         "  kept modes carry {:.6} % of the hand-over energy",

@@ -110,6 +110,10 @@ pub struct Handover {
     pub elastic_energy_before: f64,
     /// Elastic energy of the initial displacement in the deployed model, ½Σ ω_j² η_j(0)², J.
     pub elastic_energy_after: f64,
+    /// Compliant latches: their springs' energy at the hand-over, ½ Σ k_L,j (α_j − α_j^L)², J.
+    /// The deployed wing has no latch spring, so the response does not carry it (the
+    /// panels' small angles off the latch angles are projected; their spring is not).
+    pub latch_energy: f64,
     /// Notes on choices the data forced (printed as warnings).
     pub notes: Vec<String>,
 }
@@ -420,6 +424,7 @@ pub fn hand_over(
         modal_displacement: vec![0.0; modal.modes.len()],
         elastic_energy_before: 0.0,
         elastic_energy_after: 0.0,
+        latch_energy: 0.0,
         notes,
     })
 }
@@ -611,6 +616,7 @@ pub fn hand_over_coupled(
         modal_displacement,
         elastic_energy_before: coupled.elastic_energy(&y),
         elastic_energy_after,
+        latch_energy: coupled.latch_energy(&y, &vec![true; coupled.panels()]),
         notes,
     })
 }
