@@ -899,9 +899,9 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     let h = &r.handover;
     let _ = writeln!(
         o,
-        "<h3>Hand-over at the final latch</h3><p>t = {:.6} s (latch of hinge {}), method <b>{}</b>; {} s of response at {} Hz, ζ = {}, {} rigid + {} of {} elastic modes kept.</p>",
+        "<h3>Hand-over</h3><p>t = {:.6} s ({}), method <b>{}</b>; {} s of response at {} Hz, ζ = {}, {} rigid + {} of {} elastic modes kept.</p>",
         h.latch_time,
-        h.latch_hinge,
+        esc(&super::simulate::handover_instant(h)),
         h.method.name(),
         s.response.duration,
         s.response.output_rate,

@@ -289,9 +289,9 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
     let lost = h.energy_before - h.energy_after;
     let _ = writeln!(
         o,
-        "\nHand-over at t = {:.6} s (latch of hinge {}), method {}:",
+        "\nHand-over at t = {:.6} s ({}), method {}:",
         h.latch_time,
-        h.latch_hinge,
+        handover_instant(h),
         h.method.name()
     );
     let _ = writeln!(
@@ -545,4 +545,16 @@ pub fn write_simulate(
         f.draw(dir)?;
     }
     Ok(())
+}
+
+/// What the hand-over follows: a latch, or the compliant latches' settling.
+pub(crate) fn handover_instant(h: &crate::response::handover::Handover) -> String {
+    if h.after_settling {
+        format!(
+            "after the latches settled; last capture: hinge {}",
+            h.latch_hinge
+        )
+    } else {
+        format!("latch of hinge {}", h.latch_hinge)
+    }
 }

@@ -75,8 +75,12 @@ pub struct Handover {
     pub method: HandoverMethod,
     /// Time of the final latch, s.
     pub latch_time: f64,
-    /// Hinge whose latch ended the deployment (1-based).
+    /// Hinge whose latch ended the deployment (1-based); with compliant latches, the last
+    /// captured one.
     pub latch_hinge: usize,
+    /// Compliant latches: the hand-over follows the settling after the last capture, not a
+    /// latch.
+    pub after_settling: bool,
     /// Generalized impulse b = ∫Φᵀρv⁻dV (projection) or Σ Φᵀ S (impulse), per coordinate.
     pub generalized_impulse: Vec<f64>,
     /// Initial modal velocities η̇_j(0) = φ_jᵀ b, one per mode of the analysis.
@@ -411,6 +415,7 @@ pub fn hand_over(
         method,
         latch_time: last.time,
         latch_hinge: last.hinge,
+        after_settling: false,
         generalized_impulse: b,
         modal_velocity: eta_dot,
         qdot,
@@ -603,6 +608,7 @@ pub fn hand_over_coupled(
         method,
         latch_time: result.final_time,
         latch_hinge: last_hinge,
+        after_settling: last.is_none() && !result.captures.is_empty(),
         generalized_impulse: b,
         modal_velocity: eta_dot,
         qdot,
