@@ -81,7 +81,8 @@ enum Command {
     #[command(after_help = UNITS)]
     Export(#[command(flatten)] Common),
     /// The whole story: modes of the deployed spacecraft, deployment of the array, hand-over
-    /// at the final latch and the latch-excited vibration, hub drift and attitude motion.
+    /// at the final latch (or once compliant latches have settled) and the latch-excited
+    /// vibration, hub drift and attitude motion.
     /// --out writes report.html (one self-contained page), summary.json, modes.json,
     /// deployment.csv, events.json, response.csv and plots.
     #[command(after_help = UNITS)]

@@ -395,16 +395,23 @@ impl<'a, E: Engine> Run<'a, E> {
     }
 
     /// The captured hinges' largest |α̇| over the last `window` (s), read at the quarter
-    /// points of every step since the last capture, over the largest hinge rate at a capture.
+    /// points of every step since the last capture (16 per window at least), over the
+    /// largest hinge rate at a capture.
     fn rates_left(&mut self, step: &DenseStep, window: f64) -> f64 {
         let engine = self.sys.engine;
         let ro = engine.positions() + engine.rate_offset();
         let mut rates = vec![0.0; self.latch_angles.len()];
-        for k in 1..=4 {
-            let t = if k == 4 {
+        // At least the step's quarter points, and 16 points per window: a step of the
+        // adiabatic integrator can span many periods of a stiff latch, which it carries as
+        // ringing (k_L = 1e7: W = 0.04 s), and a few samples of an oscillating rate would
+        // read its envelope anywhere between zero and its top.
+        let span = self.t - step.t0;
+        let n = ((16.0 * span / window).ceil().clamp(4.0, 1e5)) as usize;
+        for k in 1..=n {
+            let t = if k == n {
                 self.t
             } else {
-                step.t0 + step.h * f64::from(k) / 4.0
+                step.t0 + span * k as f64 / n as f64
             };
             step.components(ro, t, &mut rates);
             let loudest = rates.iter().fold(0.0, |m: f64, r| m.max(r.abs()));
@@ -436,12 +443,18 @@ impl<'a, E: Engine> Run<'a, E> {
         }
     }
 
-    /// The end of the next step: the settling's end once every hinge is captured.
+    /// The end of the next step: once every hinge is captured, the settling's end, and with
+    /// [`Settle::Decayed`] at most one window ahead, so that the settling ends within a
+    /// window of the instant its criterion holds (the adiabatic integrator's steps can span
+    /// many periods of a stiff latch it carries as ringing: with k_L = 1e7 one step ran from
+    /// 2 s to the cap at 4.1 s after the capture).
     fn t_stop(&self) -> f64 {
         if self.moving() {
-            self.s.end_time
-        } else {
-            self.settle_end()
+            return self.s.end_time;
+        }
+        match self.s.settle {
+            Some(Settle::Decayed { window, .. }) => self.settle_end().min(self.t + window),
+            _ => self.settle_end(),
         }
     }
 

@@ -319,7 +319,7 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
     if h.latch_energy > 0.0 {
         let _ = writeln!(
             o,
-            "  latch springs' energy {:.6e} J ({:.2e} of the total): not carried, the deployed wing has no latch spring",
+            "  latch springs' energy {:.6e} J ({:.2e} of the kinetic + elastic energy handed over): not carried, the deployed wing has no latch spring",
             h.latch_energy,
             h.latch_energy / before.max(1e-300)
         );
@@ -388,7 +388,7 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
     let st = &s.response;
     let _ = writeln!(
         o,
-        "\nResponse over {} s after the latch ({} samples at {} Hz, ζ = {}):",
+        "\nResponse over {} s after the hand-over ({} samples at {} Hz, ζ = {}):",
         st.duration,
         r.history.times.len(),
         st.output_rate,
@@ -549,12 +549,13 @@ pub fn write_simulate(
 
 /// What the hand-over follows: a latch, or the compliant latches' settling.
 pub(crate) fn handover_instant(h: &crate::response::handover::Handover) -> String {
-    if h.after_settling {
-        format!(
-            "after the latches settled; last capture: hinge {}",
-            h.latch_hinge
-        )
-    } else {
-        format!("latch of hinge {}", h.latch_hinge)
-    }
+    use crate::deploy::Settled;
+    let how = match h.settled {
+        None => return format!("latch of hinge {}", h.latch_hinge),
+        Some(Settled::Decayed) => "after the latches settled",
+        Some(Settled::AfterTime) => "after the settle_time",
+        Some(Settled::Capped { .. }) => "at the settling's cap, the latches NOT settled",
+        Some(Settled::EndTime { .. }) => "at end_time, the latches NOT settled",
+    };
+    format!("{how}; last capture: hinge {}", h.latch_hinge)
 }

@@ -73,14 +73,14 @@ pub struct Momentum {
 pub struct Handover {
     /// The method used.
     pub method: HandoverMethod,
-    /// Time of the final latch, s.
+    /// Time of the hand-over (the final latch, or the compliant latches' settled state), s.
     pub latch_time: f64,
     /// Hinge whose latch ended the deployment (1-based); with compliant latches, the last
     /// captured one.
     pub latch_hinge: usize,
-    /// Compliant latches: the hand-over follows the settling after the last capture, not a
-    /// latch.
-    pub after_settling: bool,
+    /// Compliant latches: how the settling after the last capture, which the hand-over
+    /// follows, ended (None after a rigid latch).
+    pub settled: Option<crate::deploy::Settled>,
     /// Generalized impulse b = ∫Φᵀρv⁻dV (projection) or Σ Φᵀ S (impulse), per coordinate.
     pub generalized_impulse: Vec<f64>,
     /// Initial modal velocities η̇_j(0) = φ_jᵀ b, one per mode of the analysis.
@@ -115,8 +115,9 @@ pub struct Handover {
     /// Elastic energy of the initial displacement in the deployed model, ½Σ ω_j² η_j(0)², J.
     pub elastic_energy_after: f64,
     /// Compliant latches: their springs' energy at the hand-over, ½ Σ k_L,j (α_j − α_j^L)², J.
-    /// The deployed wing has no latch spring, so the response does not carry it (the
-    /// panels' small angles off the latch angles are projected; their spring is not).
+    /// The deployed wing has no latch spring and starts straight (the panels' small angles
+    /// off the latch angles are dropped, [`Handover::angle_mismatch`]), so the response does
+    /// not carry it.
     pub latch_energy: f64,
     /// Notes on choices the data forced (printed as warnings).
     pub notes: Vec<String>,
@@ -415,7 +416,7 @@ pub fn hand_over(
         method,
         latch_time: last.time,
         latch_hinge: last.hinge,
-        after_settling: false,
+        settled: None,
         generalized_impulse: b,
         modal_velocity: eta_dot,
         qdot,
@@ -608,7 +609,7 @@ pub fn hand_over_coupled(
         method,
         latch_time: result.final_time,
         latch_hinge: last_hinge,
-        after_settling: last.is_none() && !result.captures.is_empty(),
+        settled: if last.is_none() { result.settled } else { None },
         generalized_impulse: b,
         modal_velocity: eta_dot,
         qdot,

@@ -565,3 +565,42 @@ fn the_latch_period_is_the_captured_arrays_slowest_mode() {
     let free = latch_period(&c.chain, kl, Synchronisation::None);
     assert!(free > 1.5 * alone, "{free} vs one panel's {alone}");
 }
+
+/// The hand-over after compliant latches reports the latch springs' energy it cannot carry,
+/// ½ Σ k_L,j (α_j − α_j^L)² at the deployment's final state, and says how the settling
+/// ended: on seed_compliant the latches settle; with a hundred times less damping they
+/// still move when the deployment's end_time (70 s) comes, and that is what it says.
+#[test]
+fn the_hand_over_reports_the_latch_springs_and_how_the_settling_ended() {
+    use flexcraft::deploy::Settled;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed_compliant.toml");
+    let src = std::fs::read_to_string(path).unwrap();
+    for (damping, settled) in [("2236.0", true), ("22.36", false)] {
+        let text = src.replace("damping = 2236.0", &format!("damping = {damping}"));
+        let sc = Scenario::from_toml_str(&text, path).unwrap();
+        let sim = flexcraft::simulation::Simulation::run(&sc).unwrap();
+        let h = &sim.response.as_ref().unwrap().handover;
+        let l = sim.coupled.latch.as_ref().unwrap();
+        let off = sim.coupled.alpha_offset();
+        let expected: f64 = (0..sim.coupled.panels())
+            .map(|j| {
+                let d = sim.deployment.final_q[off + j] - sim.coupled.chain.hinges[j].latch_angle;
+                0.5 * l.stiffness[j] * d * d
+            })
+            .sum();
+        assert!(
+            (h.latch_energy - expected).abs() <= 1e-12 * expected.max(1e-300),
+            "{} vs {expected}",
+            h.latch_energy
+        );
+        if settled {
+            assert_eq!(h.settled, Some(Settled::Decayed));
+        } else {
+            assert!(
+                matches!(h.settled, Some(Settled::EndTime { ratio: Some(r) }) if r > 0.01),
+                "{:?}",
+                h.settled
+            );
+        }
+    }
+}
