@@ -127,12 +127,6 @@ fn independent_hinges_latch_in_turn_as_in_the_explicit_reference() {
 #[test]
 fn compliant_latches_capture_as_in_the_explicit_reference() {
     let sc = scenario("seed_compliant.toml", |s| s);
-    let c = sc
-        .deployment
-        .as_ref()
-        .unwrap()
-        .coupled(&sc.structure)
-        .unwrap();
     let reference = run(&sc, 6, Integrator::Explicit, 1e-10);
     let adiabatic = run(&sc, 6, Integrator::Adiabatic, 1e-8);
     let (a, b) = (&adiabatic.captures, &reference.captures);
@@ -156,17 +150,9 @@ fn compliant_latches_capture_as_in_the_explicit_reference() {
     }
     // The latches settle (rates below 1 % of the capture's for one latch period) at the same
     // time in both runs, to 2 % of that period (the runs read the rates at their own steps).
-    let w = flexcraft::deploy::latch_period(&c.chain, &c.latch.as_ref().unwrap().stiffness, c.sync);
+    let w = latch_window(&sc);
     assert!(w > 0.3 && w < 0.5, "latch period {w}");
-    for r in [&adiabatic, &reference] {
-        assert_eq!(r.settled, Some(flexcraft::deploy::Settled::Decayed));
-    }
-    assert!(
-        (adiabatic.final_time - reference.final_time).abs() < 0.02 * w,
-        "settled at {} s and {} s",
-        adiabatic.final_time,
-        reference.final_time
-    );
+    settle_together(&adiabatic, &reference, 0.02 * w);
     assert!(
         adiabatic.evaluations * 10 < reference.evaluations,
         "{} evaluations against {}",
@@ -236,23 +222,33 @@ fn a_stiff_latch_settles_as_in_the_explicit_reference() {
         s.replace("stiffness = 1.0e5", "stiffness = 1.0e7")
             .replace("damping = 2236.0", "damping = 22360.0")
     });
+    let w = latch_window(&sc);
+    assert!(w > 0.03 && w < 0.05, "latch period {w}");
+    let reference = run(&sc, 6, Integrator::Explicit, 1e-8);
+    let adiabatic = run(&sc, 6, Integrator::Adiabatic, 1e-8);
+    settle_together(&adiabatic, &reference, w);
+}
+
+/// The settling's window W of `sc`'s compliant latches ([`flexcraft::deploy::latch_period`]).
+fn latch_window(sc: &Scenario) -> f64 {
     let c = sc
         .deployment
         .as_ref()
         .unwrap()
         .coupled(&sc.structure)
         .unwrap();
-    let w = flexcraft::deploy::latch_period(&c.chain, &c.latch.as_ref().unwrap().stiffness, c.sync);
-    assert!(w > 0.03 && w < 0.05, "latch period {w}");
-    let reference = run(&sc, 6, Integrator::Explicit, 1e-8);
-    let adiabatic = run(&sc, 6, Integrator::Adiabatic, 1e-8);
-    for r in [&adiabatic, &reference] {
+    flexcraft::deploy::latch_period(&c.chain, &c.latch.as_ref().unwrap().stiffness, c.sync)
+}
+
+/// Both runs' latches settled (decayed), the two ends within `tol` s.
+fn settle_together(a: &DeploymentResult, b: &DeploymentResult, tol: f64) {
+    for r in [a, b] {
         assert_eq!(r.settled, Some(flexcraft::deploy::Settled::Decayed));
     }
     assert!(
-        (adiabatic.final_time - reference.final_time).abs() < w,
+        (a.final_time - b.final_time).abs() < tol,
         "settled at {} s and {} s",
-        adiabatic.final_time,
-        reference.final_time
+        a.final_time,
+        b.final_time
     );
 }
