@@ -293,13 +293,16 @@ struct Run<'a, E: Engine> {
     peaks: PeakTracker,
     buf: Vec<f64>,
     warnings: Vec<Warning>,
-    /// With every hinge captured: the largest captured-hinge rate |α̇| (rad/s) at the
-    /// quarter points of the steps of the last settling window, (t, rate).
+    /// With every hinge captured: the largest captured-hinge rate |α̇| (rad/s) at the points
+    /// [`Self::rates_left`] reads in the last settling window, (t, rate), decreasing.
     recent: std::collections::VecDeque<(f64, f64)>,
     /// How the settling ended, once it has.
     settled: Option<Settled>,
     /// The time of the last impact or capture (none yet: −∞), s.
     last_event: f64,
+    /// The engine's latch period ([`Engine::latch_period`]: a small eigenproblem, so
+    /// computed once), s.
+    latch_period: f64,
     /// The current step's observations resolve the motion, so that the peak tracker may
     /// interpolate between them; false where the adiabatic stepper's ringing turns by more
     /// than [`LOAD_PHASE`] between them (a parabola through such points is no peak).
@@ -337,6 +340,7 @@ impl<'a, E: Engine> Run<'a, E> {
             recent: std::collections::VecDeque::new(),
             settled: None,
             last_event: f64::NEG_INFINITY,
+            latch_period: engine.latch_period(),
             resolved: true,
         }
     }
@@ -364,24 +368,25 @@ impl<'a, E: Engine> Run<'a, E> {
         }
     }
 
-    /// After a step once every hinge is captured: the captured hinges' rates at the step's
-    /// quarter points (from its dense output). With [`Settle::Decayed`] the settling ends
-    /// once they have stayed below [`SETTLE_TOLERANCE`] times the largest rate at a capture
-    /// for one window since the last capture, or at its cap.
+    /// After a step once every hinge is captured. With [`Settle::Decayed`] the settling ends
+    /// once the captured hinges' rates ([`Self::rates_left`]) have stayed below
+    /// [`SETTLE_TOLERANCE`] times the largest rate at a capture for one window since the
+    /// last capture, or at its cap; with [`Settle::For`] after its time; either way at
+    /// `end_time` at the latest.
     fn watch_settling(&mut self, step: &DenseStep) {
         let (Some(settle), Some(last)) = (self.s.settle, self.captures.last()) else {
             return;
         };
         let last_time = last.time;
-        let ratio = match settle {
-            Settle::For(_) => None,
-            Settle::Decayed { window, .. } => Some(self.rates_left(step, window)),
-        };
-        let decayed = match settle {
+        let (ratio, decayed) = match settle {
+            Settle::For(_) => (None, false),
             Settle::Decayed { window, .. } => {
-                self.t - last_time >= window && ratio.is_some_and(|r| r <= SETTLE_TOLERANCE)
+                let r = self.rates_left(step, window);
+                (
+                    Some(r),
+                    self.t - last_time >= window && r <= SETTLE_TOLERANCE,
+                )
             }
-            Settle::For(_) => false,
         };
         self.settled = if decayed {
             Some(Settled::Decayed)
@@ -573,15 +578,16 @@ impl<'a, E: Engine> Run<'a, E> {
         } else {
             0.0
         };
-        ringing.max(self.sys.engine.latch_period())
+        ringing.max(self.latch_period)
     }
 
     /// Samples at k / rate within (step.t0, t_limit], and the tracked loads observed between
     /// them at [`load_times`] during a latch-up ([`Self::latch_up_window`]).
     fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
         let r = self.alpha_range();
-        let inner = if step.t0 < self.last_event + self.latch_up_window(step) {
-            load_times(step, t_limit)
+        let fastest = step.fastest_ringing();
+        let inner = if fastest > 0.0 && step.t0 < self.last_event + self.latch_up_window(step) {
+            load_times(fastest, step.t0, t_limit)
         } else {
             Vec::new()
         };
@@ -592,8 +598,7 @@ impl<'a, E: Engine> Run<'a, E> {
         // Resolved: the observations (inner points and the end) no farther apart than
         // LOAD_PHASE / ω (the spacing's rounding aside).
         let gaps = inner.len() as f64 + 1.0;
-        self.resolved =
-            step.fastest_ringing() * (t_limit - step.t0) <= LOAD_PHASE * gaps * (1.0 + 1e-9);
+        self.resolved = fastest * (t_limit - step.t0) <= LOAD_PHASE * gaps * (1.0 + 1e-9);
         let mut inner = inner.into_iter().peekable();
         loop {
             let tk = self.next_k as f64 / self.s.output_rate;
@@ -801,21 +806,19 @@ const LATCH_UP_PERIODS: f64 = 4.0;
 /// (rad) within a step, the loads are observed inside the step too.
 const LOAD_PHASE: f64 = 0.125;
 
-/// The times inside (step.t0, t_limit) at which the tracked loads are observed besides the
-/// step's end: none where the dense output is the integrator's polynomial (the steps resolve
-/// the motion), and for the adiabatic stepper's ringing, which its steps do not resolve, a
-/// spacing of [`LOAD_PHASE`] / ω of its fastest carried mode, so that the peak tracker's
-/// parabola finds a peak of that mode to ~0.25 (ωδ)³ ≈ 5e-4 relative.
-fn load_times(step: &DenseStep, t_limit: f64) -> Vec<f64> {
-    let span = t_limit - step.t0;
-    let turns = step.fastest_ringing() * span / LOAD_PHASE;
+/// The times inside (t0, t_limit) at which the tracked loads are observed besides the step's
+/// end, for the adiabatic stepper's ringing, which its steps do not resolve (the explicit
+/// and implicit steps do: no ringing, ω = 0, no points): a spacing of [`LOAD_PHASE`] / ω,
+/// ω the fastest carried mode's ([`DenseStep::fastest_ringing`]), so that the peak
+/// tracker's parabola finds a peak of that mode to ~0.25 (ωδ)³ ≈ 5e-4 relative.
+fn load_times(fastest: f64, t0: f64, t_limit: f64) -> Vec<f64> {
+    let span = t_limit - t0;
+    let turns = fastest * span / LOAD_PHASE;
     if turns.is_nan() || turns <= 1.0 {
         return Vec::new();
     }
     let n = turns.ceil().min(MAX_LOAD_TIMES) as usize;
-    (1..n)
-        .map(|k| step.t0 + span * k as f64 / n as f64)
-        .collect()
+    (1..n).map(|k| t0 + span * k as f64 / n as f64).collect()
 }
 
 /// Runs `engine` from release until every hinge has latched or the end time (at most
