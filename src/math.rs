@@ -241,6 +241,25 @@ impl Mul<f64> for Mat3 {
     }
 }
 
+/// Σ a_i b_i with four partial sums (lets the compiler use vector registers).
+pub fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            acc[q] += x[q] * y[q];
+        }
+    }
+    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
 /// The lower Cholesky factor L (row-major k × k, L Lᵀ = A) of the symmetric k × k matrix `a`
 /// (row-major, lower triangle read), or the first pivot that is not above `min_pivot`.
 /// Hand-written for the small dense matrices of the Monte Carlo statistics (a correlation

@@ -838,6 +838,19 @@ impl OdeSystem for SlowSystem<'_> {
             }
         }
     }
+    fn speed_offset(&self) -> Option<usize> {
+        self.sys.speed_offset()
+    }
+    fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[(usize, f64)], out: &mut [Vec<f64>]) {
+        self.sys.rhs_speeds(t, y, changes, out);
+        if let Some(f) = self.forcing {
+            for dy in out.iter_mut() {
+                for (d, g) in dy.iter_mut().zip(f) {
+                    *d += g;
+                }
+            }
+        }
+    }
     fn jacobian(&self, _t: f64, y: &[f64], jac: &mut Mat<f64>) -> bool {
         match self.cached {
             Some((at, j)) if at.as_slice() == y => {

@@ -38,7 +38,7 @@ use super::attitude::{self, Quaternion};
 use super::base::BaseModel;
 use super::chain::{Chain, P2};
 use super::inertia::{combine, AtShape};
-use crate::math::{Mat3, Vec3};
+use crate::math::{dot4, Mat3, Vec3};
 use crate::structure::HubMotion;
 use faer::{Mat, Side};
 use std::cell::RefCell;
@@ -316,26 +316,30 @@ impl Coupled {
 
     /// The evaluation's parts into `ws`: the base block M_bb = M_base + Bᵀ M₁₁ B of the mass
     /// matrix, c and Q always; the whole mass matrix (with the chain's Bᵀ M₁₂ and M₂₂, O(N²))
-    /// when `dense`.
+    /// when `dense`. In two phases: the configuration's ([`Coupled::assemble_configuration`],
+    /// the positions alone) and the motion's ([`Coupled::assemble_motion`]).
     fn assemble_parts(&self, y: &[f64], ws: &mut Workspace, dense: bool) {
+        self.assemble_configuration(y, ws, dense);
+        self.assemble_motion(y, ws);
+    }
+
+    /// What depends on the positions alone (η and α): the invariants at η, the hinge frame,
+    /// B, the chain's mass blocks M₁₁ and M₁₂ and outboard sums, M_bb (and the dense M when
+    /// `dense`). The speeds' columns of a Jacobian by differences share it
+    /// ([`Coupled::rhs_speeds`]).
+    fn assemble_configuration(&self, y: &[f64], ws: &mut Workspace, dense: bool) {
         let s = self.view(y);
         let base = &self.base;
         let inv = &base.invariants;
-        let (h, m, n) = (self.hub_dof(), self.modes(), self.panels());
+        let (h, m) = (self.hub_dof(), self.modes());
         let nb = h + m;
         inv.at_into(s.eta, &mut ws.at);
         // Hinge frame.
         let theta = combine(&base.hinge_rotations, s.eta);
-        let theta_dot = combine(&base.hinge_rotations, s.eta_dot);
         let e0 = from_cols(base.frame);
         let frame = attitude::exp(theta).matmul(e0);
         let jl = attitude::left_jacobian(theta);
         let hinge = base.hinge + combine(&base.hinge_shapes, s.eta);
-        let p_dot = combine(&base.hinge_shapes, s.eta_dot);
-        let omega_rel = jl.apply(theta_dot);
-        let v_h = s.v + s.w.cross(hinge) + p_dot;
-        let a_h = s.w.cross(p_dot) + s.w.cross(v_h);
-        let wd_h = attitude::left_jacobian_rate(theta, theta_dot) + s.w.cross(omega_rel);
         let et = frame.transpose();
         // B: base speeds → [V_H; Ω_H], hinge components (6 × nb, row-major).
         let b = &mut ws.b;
@@ -359,30 +363,15 @@ impl Coupled {
                 b[(3 + i) * nb + h + k] = rv.get(i);
             }
         }
-        let omega_h = et.apply(s.w + omega_rel);
-        let a_bias = {
-            let a = et.apply(a_h);
-            let wd = et.apply(wd_h);
-            [
-                a.get(0),
-                a.get(1),
-                a.get(2),
-                wd.get(0),
-                wd.get(1),
-                wd.get(2),
-            ]
-        };
         ws.frame = frame;
         ws.hinge = hinge;
-        ws.a_bias = a_bias;
-        self.chain_blocks(s.alpha, s.alpha_dot, omega_h, &mut ws.chain, dense);
-        // Assemble.
-        let ns = nb + n;
+        ws.theta = theta;
+        ws.jl = jl;
+        self.chain_mass_blocks(s.alpha, &mut ws.chain, dense);
         refill(&mut ws.mbb, nb * nb, 0.0);
-        refill(&mut ws.bias, ns, 0.0);
-        self.base_terms(&s, ws);
-        let (b, mbb, bias) = (&ws.b, &mut ws.mbb, &mut ws.bias);
-        let (m11, m12) = (&ws.chain.m11, &ws.chain.m12);
+        self.base_mass(ws);
+        let (b, mbb) = (&ws.b, &mut ws.mbb);
+        let m11 = &ws.chain.m11;
         // [B 0; 0 I]ᵀ M_c [B 0; 0 I] by blocks: Bᵀ M₁₁ B here, Bᵀ M₁₂, M₂₁ B and M₂₂ below
         // when dense (loops: the blocks are small, and a general product's set-up costs more
         // than the arithmetic).
@@ -402,6 +391,48 @@ impl Coupled {
                 *x += (0..6).map(|k| bi[k] * mj[k]).sum::<f64>();
             }
         }
+        if dense {
+            self.dense_mass(ws);
+        } else {
+            // Nothing of an earlier dense evaluation (perhaps of another model) stays readable.
+            ws.mass.clear();
+            ws.chain.mc.clear();
+        }
+    }
+
+    /// What the speeds enter, at the configuration [`Coupled::assemble_configuration`] left
+    /// in `ws` (the same positions): H's bias acceleration, the chain's bias b_c, c and Q.
+    fn assemble_motion(&self, y: &[f64], ws: &mut Workspace) {
+        let s = self.view(y);
+        let base = &self.base;
+        let (h, m, n) = (self.hub_dof(), self.modes(), self.panels());
+        let nb = h + m;
+        let (theta, jl, hinge, et) = (ws.theta, ws.jl, ws.hinge, ws.frame.transpose());
+        let theta_dot = combine(&base.hinge_rotations, s.eta_dot);
+        let p_dot = combine(&base.hinge_shapes, s.eta_dot);
+        let omega_rel = jl.apply(theta_dot);
+        let v_h = s.v + s.w.cross(hinge) + p_dot;
+        let a_h = s.w.cross(p_dot) + s.w.cross(v_h);
+        let wd_h = attitude::left_jacobian_rate(theta, theta_dot) + s.w.cross(omega_rel);
+        let omega_h = et.apply(s.w + omega_rel);
+        let a_bias = {
+            let a = et.apply(a_h);
+            let wd = et.apply(wd_h);
+            [
+                a.get(0),
+                a.get(1),
+                a.get(2),
+                wd.get(0),
+                wd.get(1),
+                wd.get(2),
+            ]
+        };
+        ws.a_bias = a_bias;
+        self.chain_bias(s.alpha_dot, omega_h, &mut ws.chain);
+        let ns = nb + n;
+        refill(&mut ws.bias, ns, 0.0);
+        self.base_bias(&s, ws);
+        let (m11, m12) = (&ws.chain.m11, &ws.chain.m12);
         // Chain bias with H's bias acceleration: b_c + M_c [a_b; 0], mapped by [B 0; 0 I]ᵀ
         // (M₂₁ has the planar columns 0, 1 and 5 only).
         let cb = &mut ws.cb;
@@ -413,18 +444,12 @@ impl Coupled {
         for (c, col) in m12.iter().enumerate() {
             cb[6 + c] += col[0] * a_bias[0] + col[1] * a_bias[1] + col[2] * a_bias[5];
         }
-        for (x, bj) in bias.iter_mut().zip(bt.iter()) {
+        let bias = &mut ws.bias;
+        for (x, bj) in bias.iter_mut().zip(ws.bt.iter()) {
             *x += (0..6).map(|i| bj[i] * cb[i]).sum::<f64>();
         }
         for c in 0..n {
             bias[nb + c] += cb[6 + c];
-        }
-        if dense {
-            self.dense_mass(ws);
-        } else {
-            // Nothing of an earlier dense evaluation (perhaps of another model) stays readable.
-            ws.mass.clear();
-            ws.chain.mc.clear();
         }
         // Applied forces.
         let force = &mut ws.force;
@@ -493,13 +518,13 @@ impl Coupled {
         below * d(k - 1) + d(k)
     }
 
-    /// The base's own mass matrix and velocity terms over [v, ω, η̇] (see [`super::inertia`]),
-    /// added to `ws.mbb` and `ws.bias` (`ws.at` holds the invariants at η).
-    fn base_terms(&self, s: &View<'_>, ws: &mut Workspace) {
+    /// The base's own mass matrix over [v, ω, η̇] (see [`super::inertia`]), added to
+    /// `ws.mbb` (`ws.at` holds the invariants at η).
+    fn base_mass(&self, ws: &mut Workspace) {
         let inv = &self.base.invariants;
         let (h, m) = (self.hub_dof(), self.modes());
         let ns = h + m; // the stride of M_bb
-        let (at, mass, bias) = (&ws.at, &mut ws.mbb, &mut ws.bias);
+        let (at, mass) = (&ws.at, &mut ws.mbb);
         for a in 0..m {
             for c in 0..m {
                 mass[(h + a) * ns + h + c] += inv.mee[(a, c)];
@@ -525,6 +550,17 @@ impl Coupled {
                 mass[(6 + k) * ns + 3 + i] += at.l[k].get(i);
             }
         }
+    }
+
+    /// The base's own velocity terms over [v, ω, η̇] (see [`super::inertia`]), added to
+    /// `ws.bias` (`ws.at` holds the invariants at η).
+    fn base_bias(&self, s: &View<'_>, ws: &mut Workspace) {
+        let inv = &self.base.invariants;
+        let (h, m) = (self.hub_dof(), self.modes());
+        if h == 0 {
+            return;
+        }
+        let (at, bias) = (&ws.at, &mut ws.bias);
         let (v, w) = (s.v, s.w);
         let (p, hh) = inv.momenta(at, v, w, s.eta_dot);
         let s_dot = inv.s_rate(s.eta_dot);
@@ -547,73 +583,43 @@ impl Coupled {
             bias[i] += cv.get(i);
             bias[3 + i] += cw.get(i);
         }
+        // ġ_k − ∂T/∂η_k: L̇_kᵀ ω from ġ, and ∂T/∂η_k = v·(ω × S_k) + ½ ωᵀ J_{,k} ω + ωᵀ L1_k η̇,
+        // whose last term is −ω·L̇_k (L1 antisymmetric: Σ_c L1_kc η̇_c = −Σ_c L1_ck η̇_c).
         for k in 0..m {
-            let dt_deta = v.dot(w.cross(inv.s[k]))
-                + 0.5 * w.dot(at.dj[k].apply(w))
-                + (0..m)
-                    .map(|c| w.dot(inv.l1[k * m + c]) * s.eta_dot[c])
-                    .sum::<f64>();
-            bias[6 + k] += l_dot[k].dot(w) - dt_deta;
+            let dt_deta = v.dot(w.cross(inv.s[k])) + 0.5 * w.dot(at.dj[k].apply(w));
+            bias[6 + k] += 2.0 * l_dot[k].dot(w) - dt_deta;
         }
     }
 
-    /// The chain's block matrix M_c over [A; Ω̇; α̈] and its bias b_c for H's angular
-    /// velocity `omega` (hinge components), all in hinge components, into `cw`: M₁₁ and the
+    /// The chain's mass blocks over [A; Ω̇; α̈] (hinge components) into `cw`: M₁₁ and the
     /// coupling columns M₁₂ always, the dense M_c when `dense` (the O(N) elimination of
-    /// [`super::articulated`] does without M₂₂).
-    fn chain_blocks(
-        &self,
-        alpha: &[f64],
-        alpha_dot: &[f64],
-        omega: Vec3,
-        cw: &mut ChainWork,
-        dense: bool,
-    ) {
+    /// [`super::articulated`] does without M₂₂), with the configuration they need (angles,
+    /// centres, hinge points, inertia tensors, outboard sums).
+    fn chain_mass_blocks(&self, alpha: &[f64], cw: &mut ChainWork, dense: bool) {
         let ch = &self.chain;
         let n = ch.len();
-        cw.configure(ch, alpha, alpha_dot);
+        cw.configure(ch, alpha);
         let z = Vec3::new(0.0, 0.0, 1.0);
         let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
-        let (centres, hinges, rates) = (&cw.centres, &cw.hinges, &cw.rates);
-        // Panel inertia tensors in hinge components, relative velocities and accelerations.
+        let (centres, hinges) = (&cw.centres, &cw.hinges);
+        // Panel inertia tensors in hinge components.
         cw.inertia.clear();
-        cw.cdot.clear();
-        cw.cdd.clear();
-        let (mut vh, mut ah) = (Vec3::ZERO, Vec3::ZERO);
         for i in 0..n {
             cw.inertia.push(self.panel_tensor(i, cw.phi[i]));
-            let r = centres[i] - hinges[i];
-            let l = hinges[i + 1] - hinges[i];
-            let wi = rates[i];
-            cw.cdot.push(vh + z.cross(r) * wi);
-            cw.cdd.push(ah - r * (wi * wi));
-            vh = vh + z.cross(l) * wi;
-            ah = ah - l * (wi * wi);
         }
-        let nc = 6 + n;
         refill(&mut cw.m12, n, [0.0; 3]);
-        let bc = &mut cw.bc;
-        refill(bc, nc, 0.0);
-        // Outboard sums, tip to root: mass, first moment, rotational inertia about ẑ and the
-        // bias forces' resultant and moment about H.
+        // Outboard sums, tip to root: mass, first moment, rotational inertia about ẑ.
         let (mut mt, mut s1) = (0.0, Vec3::ZERO);
         let mut jc = Mat3::ZERO;
-        let (mut fb, mut mb) = (Vec3::ZERO, Vec3::ZERO);
         let mut iz = 0.0;
         let mut mzz = 0.0; // Σ m_i |c_i|² about H (in-plane)
         for i in (0..n).rev() {
             let p = &ch.panels[i];
             let c = centres[i];
-            let wv = omega + z * rates[i];
-            let ab = omega.cross(omega.cross(c)) + omega.cross(cw.cdot[i]) * 2.0 + cw.cdd[i];
-            let eb = omega.cross(z * rates[i]);
             let ii = cw.inertia[i];
-            let rot = ii.apply(eb) + wv.cross(ii.apply(wv));
             mt += p.mass;
             s1 = s1 + c * p.mass;
             jc = jc + (Mat3::IDENTITY * c.dot(c) - c.outer(c)) * p.mass + ii;
-            fb = fb + ab * p.mass;
-            mb = mb + c.cross(ab * p.mass) + rot;
             iz += self.panel_inertia[i][2];
             mzz += p.mass * c.dot(c);
             // Hinge l = i: outboard sums about h_i.
@@ -625,8 +631,6 @@ impl Coupled {
             let fcol = z.cross(bl) * dl;
             let mcol = dl * (al + hl.dot(bl));
             cw.m12[i] = [fcol.get(0), fcol.get(1), mcol];
-            // d_l ẑ·[Σ (c_j − h_l) × m_j a_j^b + rot_j] = d_l ẑ·(mb − h_l × fb).
-            bc[6 + i] = dl * z.dot(mb - hl.cross(fb));
         }
         let st = s1.skew();
         let m11 = &mut cw.m11;
@@ -638,12 +642,57 @@ impl Coupled {
                 m11[3 + r][c] = st.get(r, c);
                 m11[3 + r][3 + c] = jc.get(r, c);
             }
-            bc[r] = fb.get(r);
-            bc[3 + r] = mb.get(r);
         }
         cw.outboard_sums(ch);
         if dense {
             cw.dense_blocks();
+        }
+    }
+
+    /// The chain's bias b_c (the forces and moments of zero accelerations) for the opening
+    /// rates α̇ and H's angular velocity `omega` (hinge components), at the configuration
+    /// [`Coupled::chain_mass_blocks`] left in `cw`.
+    fn chain_bias(&self, alpha_dot: &[f64], omega: Vec3, cw: &mut ChainWork) {
+        let ch = &self.chain;
+        let n = ch.len();
+        cw.rates_of(alpha_dot);
+        let z = Vec3::new(0.0, 0.0, 1.0);
+        let d = |k: usize| if k % 2 == 0 { -1.0 } else { 1.0 };
+        let (centres, hinges, rates) = (&cw.centres, &cw.hinges, &cw.rates);
+        // Centre velocities and accelerations relative to H.
+        cw.cdot.clear();
+        cw.cdd.clear();
+        let (mut vh, mut ah) = (Vec3::ZERO, Vec3::ZERO);
+        for i in 0..n {
+            let r = centres[i] - hinges[i];
+            let l = hinges[i + 1] - hinges[i];
+            let wi = rates[i];
+            cw.cdot.push(vh + z.cross(r) * wi);
+            cw.cdd.push(ah - r * (wi * wi));
+            vh = vh + z.cross(l) * wi;
+            ah = ah - l * (wi * wi);
+        }
+        let bc = &mut cw.bc;
+        refill(bc, 6 + n, 0.0);
+        // Outboard sums, tip to root: the bias forces' resultant and moment about H.
+        let (mut fb, mut mb) = (Vec3::ZERO, Vec3::ZERO);
+        for i in (0..n).rev() {
+            let p = &ch.panels[i];
+            let c = centres[i];
+            let wv = omega + z * rates[i];
+            let ab = omega.cross(omega.cross(c)) + omega.cross(cw.cdot[i]) * 2.0 + cw.cdd[i];
+            let eb = omega.cross(z * rates[i]);
+            let ii = cw.inertia[i];
+            let rot = ii.apply(eb) + wv.cross(ii.apply(wv));
+            fb = fb + ab * p.mass;
+            mb = mb + c.cross(ab * p.mass) + rot;
+            // d_l ẑ·[Σ (c_j − h_l) × m_j a_j^b + rot_j] = d_l ẑ·(mb − h_l × fb).
+            let hl = hinges[i];
+            bc[6 + i] = d(i) * z.dot(mb - hl.cross(fb));
+        }
+        for r in 0..3 {
+            bc[r] = fb.get(r);
+            bc[3 + r] = mb.get(r);
         }
     }
 
@@ -678,6 +727,11 @@ impl Coupled {
     /// [`Coupled::assemble`] with the latch moments of the captured hinges in the forces.
     fn assemble_captured(&self, y: &[f64], captured: &[bool], ws: &mut Workspace, dense: bool) {
         self.assemble_parts(y, ws, dense);
+        self.add_latch_moments(y, captured, ws);
+    }
+
+    /// The captured hinges' latch moments added to the forces in `ws`.
+    fn add_latch_moments(&self, y: &[f64], captured: &[bool], ws: &mut Workspace) {
         let nb = self.rate_offset();
         let s = self.view(y);
         for j in 0..self.panels() {
@@ -748,21 +802,35 @@ impl Coupled {
         free: &[bool],
         udot: &mut [f64],
     ) {
+        if self.factor_chain(ws, sw, free) {
+            self.solve_chain(ws, r, sw, free, udot);
+        } else {
+            udot.fill(f64::NAN);
+        }
+    }
+
+    /// An ideal cable ties the hinges and some are free: the chain moves on its one speed.
+    fn cable_speed(&self, free: &[bool]) -> bool {
+        self.sync == Synchronisation::IdealCable && free.iter().any(|f| *f)
+    }
+
+    /// [`Coupled::eliminate_chain`]'s part that depends on the configuration alone: the
+    /// reduced base block (M_bb − B_pᵀ M₁₂,F Y B_p, or M_bb bordered by the cable's speed)
+    /// factored into `sw.zmz`, Y into `sw.fast.y[1..=3]` (the cable's r into `sw.fast.y[1]`);
+    /// false when the factorisation fails.
+    fn factor_chain(&self, ws: &Workspace, sw: &mut SolveWork, free: &[bool]) -> bool {
         let (nb, n) = (self.rate_offset(), self.panels());
         let cw = &ws.chain;
-        let (rb, ra) = r.split_at(nb);
         // Rows A_x, A_y, Ω̇_z of B (6 × nb).
         let bp = |k: usize, j: usize| ws.b[[0, 1, 5][k] * nb + j];
         let fw = &mut sw.fast;
-        let cable = self.sync == Synchronisation::IdealCable && free.iter().any(|f| *f);
+        let cable = self.cable_speed(free);
         let k = nb + usize::from(cable);
         let a = &mut sw.zmz;
         refill(a, k * k, 0.0);
         for i in 0..nb {
             a[i * k..i * k + nb].copy_from_slice(&ws.mbb[i * nb..(i + 1) * nb]);
         }
-        refill(&mut sw.w, k, 0.0);
-        sw.w[..nb].copy_from_slice(rb);
         refill(&mut fw.y[0], n, 0.0);
         if cable {
             let rc = &mut fw.y[1];
@@ -784,7 +852,6 @@ impl Coupled {
                 a[j * k + nb] = v;
             }
             a[nb * k + nb] = srr;
-            sw.w[nb] = dot(rc, ra);
         } else {
             fw.panels.clear();
             fw.panels.extend((0..n).map(|i| articulated::PlanarPanel {
@@ -794,23 +861,19 @@ impl Coupled {
                 hinge: [cw.hinges[i].get(0), cw.hinges[i].get(1)],
             }));
             if !fw.art.factor(&fw.panels, free) {
-                udot.fill(f64::NAN);
-                return;
+                return false;
             }
-            // y[0] = M₂₂⁻¹ (Q − c)_α, y[1 + q] = M₂₂⁻¹ M₂₁[:, q].
-            fw.art.solve(ra, &mut fw.y[0]);
+            // y[1 + q] = M₂₂⁻¹ M₂₁[:, q].
             for q in 0..3 {
                 fw.tau.clear();
                 fw.tau.extend(cw.m12.iter().map(|col| col[q]));
                 refill(&mut fw.y[1 + q], n, 0.0);
                 fw.art.solve(&fw.tau, &mut fw.y[1 + q]);
             }
-            // Δ = M₁₂ Y (3 × 3) and M₁₂ y.
+            // Δ = M₁₂ Y (3 × 3).
             let mut delta = [[0.0; 3]; 3];
-            let mut my = [0.0; 3];
             for (c, col) in cw.m12.iter().enumerate() {
                 for q in 0..3 {
-                    my[q] += col[q] * fw.y[0][c];
                     for p in 0..3 {
                         delta[q][p] += col[q] * fw.y[1 + p][c];
                     }
@@ -822,14 +885,47 @@ impl Coupled {
                 for j in 0..nb {
                     a[i * k + j] -= (0..3).map(|p| di[p] * bp(p, j)).sum::<f64>();
                 }
+            }
+        }
+        cholesky_in_place(a, k)
+    }
+
+    /// [`Coupled::eliminate_chain`]'s part that depends on `r` = Q − c, with the factor of
+    /// [`Coupled::factor_chain`] in `sw`.
+    fn solve_chain(
+        &self,
+        ws: &Workspace,
+        r: &[f64],
+        sw: &mut SolveWork,
+        free: &[bool],
+        udot: &mut [f64],
+    ) {
+        let (nb, n) = (self.rate_offset(), self.panels());
+        let cw = &ws.chain;
+        let (rb, ra) = r.split_at(nb);
+        let bp = |k: usize, j: usize| ws.b[[0, 1, 5][k] * nb + j];
+        let fw = &mut sw.fast;
+        let cable = self.cable_speed(free);
+        let k = nb + usize::from(cable);
+        refill(&mut sw.w, k, 0.0);
+        sw.w[..nb].copy_from_slice(rb);
+        if cable {
+            sw.w[nb] = dot(&fw.y[1], ra);
+        } else {
+            // y[0] = M₂₂⁻¹ (Q − c)_α and M₁₂ y.
+            refill(&mut fw.y[0], n, 0.0);
+            fw.art.solve(ra, &mut fw.y[0]);
+            let mut my = [0.0; 3];
+            for (c, col) in cw.m12.iter().enumerate() {
+                for q in 0..3 {
+                    my[q] += col[q] * fw.y[0][c];
+                }
+            }
+            for i in 0..nb {
                 sw.w[i] -= (0..3).map(|q| bp(q, i) * my[q]).sum::<f64>();
             }
         }
-        if !cholesky_in_place(a, k) {
-            udot.fill(f64::NAN);
-            return;
-        }
-        cholesky_solve(a, k, &mut sw.w);
+        cholesky_solve(&sw.zmz, k, &mut sw.w);
         udot[..nb].copy_from_slice(&sw.w[..nb]);
         if cable {
             let wd = sw.w[nb];
@@ -1077,15 +1173,75 @@ impl Coupled {
     /// acting.
     /// Evaluates into a workspace kept per thread: no allocation once it is sized.
     pub fn rhs_captured(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
-        let np = self.positions();
         WORKSPACE.with_borrow_mut(|(ws, sw)| {
-            self.assemble_captured(y, captured, ws, false);
-            // Q − c, in place of Q.
-            for (f, c) in ws.force.iter_mut().zip(&ws.bias) {
-                *f -= c;
-            }
-            self.eliminate_chain(ws, &ws.force, sw, free, &mut dy[np..]);
+            self.assemble_configuration(y, ws, false);
+            let factored = self.factor_chain(ws, sw, free);
+            self.rhs_at_configuration(y, free, captured, factored, ws, sw, dy);
         });
+    }
+
+    /// [`Coupled::rhs_captured`] at y with one speed changed, for each (component, value) of
+    /// `changes` in turn, into the rows of `out`: the configuration's work (the invariants at
+    /// η, B, M_bb, the chain's mass blocks and the reduced matrix's factorisation, about two
+    /// thirds of an evaluation) is done once for all of them. Each row equals
+    /// [`Coupled::rhs_captured`] at its state, bit for bit. A change of a position (not a
+    /// speed) is evaluated on its own.
+    pub fn rhs_captured_speeds(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        changes: &[(usize, f64)],
+        out: &mut [Vec<f64>],
+    ) {
+        let np = self.positions();
+        let mut yp = y.to_vec();
+        WORKSPACE.with_borrow_mut(|(ws, sw)| {
+            self.assemble_configuration(y, ws, false);
+            let mut factored = self.factor_chain(ws, sw, free);
+            for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
+                yp[c] = v;
+                if c < np {
+                    self.assemble_configuration(&yp, ws, false);
+                    let f = self.factor_chain(ws, sw, free);
+                    self.rhs_at_configuration(&yp, free, captured, f, ws, sw, dy);
+                    // Back to y's configuration for the changes that follow.
+                    self.assemble_configuration(y, ws, false);
+                    factored = self.factor_chain(ws, sw, free);
+                } else {
+                    self.rhs_at_configuration(&yp, free, captured, factored, ws, sw, dy);
+                }
+                yp[c] = y[c];
+            }
+        });
+    }
+
+    /// dy/dt at y, whose configuration [`Coupled::assemble_configuration`] and
+    /// [`Coupled::factor_chain`] left in `ws` and `sw` (`factored`: the factorisation
+    /// succeeded; else the accelerations are NaN, which stops the run).
+    #[allow(clippy::too_many_arguments)]
+    fn rhs_at_configuration(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        factored: bool,
+        ws: &mut Workspace,
+        sw: &mut SolveWork,
+        dy: &mut [f64],
+    ) {
+        let np = self.positions();
+        self.assemble_motion(y, ws);
+        self.add_latch_moments(y, captured, ws);
+        // Q − c, in place of Q.
+        for (f, c) in ws.force.iter_mut().zip(&ws.bias) {
+            *f -= c;
+        }
+        if factored {
+            self.solve_chain(ws, &ws.force, sw, free, &mut dy[np..]);
+        } else {
+            dy[np..].fill(f64::NAN);
+        }
         let s = self.view(y);
         let m = self.modes();
         let pe = self.kinematic_positions();
@@ -1257,6 +1413,9 @@ struct Workspace {
     /// Hinge frame axes (hub components) and hinge point.
     frame: Mat3,
     hinge: Vec3,
+    /// The hinge frame's small rotation θ(η) and its left Jacobian.
+    theta: Vec3,
+    jl: Mat3,
     /// B (6 × nb).
     b: Vec<f64>,
     /// [A; Ω̇] of H for zero accelerations.
@@ -1333,10 +1492,9 @@ struct ChainWork {
 }
 
 impl ChainWork {
-    /// Panel angles, centres, hinge points and angle rates: [`Chain::configuration`] and
-    /// [`Chain::phi_rates`] for the held hub of the coupled chain, in the same arithmetic,
-    /// without allocating.
-    fn configure(&mut self, ch: &Chain, alpha: &[f64], alpha_dot: &[f64]) {
+    /// Panel angles, centres and hinge points: [`Chain::configuration`] for the held hub of
+    /// the coupled chain, in the same arithmetic, without allocating.
+    fn configure(&mut self, ch: &Chain, alpha: &[f64]) {
         debug_assert_eq!(ch.hub_dof(), 0);
         let theta: f64 = 0.0;
         let (s, c) = theta.sin_cos();
@@ -1348,9 +1506,7 @@ impl ChainWork {
         self.phi.clear();
         self.centres.clear();
         self.hinges.clear();
-        self.rates.clear();
         self.hinges.push(Vec3::new(hp[0], hp[1], 0.0));
-        let mut w = 0.0;
         for (i, p) in ch.panels.iter().enumerate() {
             let a = alpha[i];
             let f = if i == 0 {
@@ -1368,8 +1524,17 @@ impl ChainWork {
             ));
             hp = [hp[0] + p.length * ev[0], hp[1] + p.length * ev[1]];
             self.hinges.push(Vec3::new(hp[0], hp[1], 0.0));
+        }
+    }
+
+    /// The panels' angle rates φ̇_i from the opening rates: [`Chain::phi_rates`] for the held
+    /// hub, in the same arithmetic, without allocating.
+    fn rates_of(&mut self, alpha_dot: &[f64]) {
+        self.rates.clear();
+        let mut w = 0.0;
+        for (i, a) in alpha_dot.iter().enumerate() {
             let d = if i % 2 == 0 { -1.0 } else { 1.0 };
-            w += d * alpha_dot[i];
+            w += d * a;
             self.rates.push(w);
         }
     }
@@ -1598,25 +1763,6 @@ fn cholesky_solve(l: &[f64], k: usize, x: &mut [f64]) {
         }
         x[i] = v / l[i * k + i];
     }
-}
-
-/// Σ a_i b_i with four partial sums (lets the compiler use vector registers).
-fn dot4(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a, b) = (&a[..n], &b[..n]);
-    let mut acc = [0.0; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for q in 0..4 {
-            acc[q] += x[q] * y[q];
-        }
-    }
-    let mut s = (acc[0] + acc[2]) + (acc[1] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
 }
 
 /// λ = (CCᵀ)⁻¹ C r.

@@ -22,7 +22,7 @@
 //! torsional and lumped inertias are small). The same invariants of a beam's outboard
 //! subtree give its root loads: F = ṗ + ω × p and M_O = ḣ + ω × h + v × p.
 
-use crate::math::{Mat3, Vec3};
+use crate::math::{dot4, Mat3, Vec3};
 use faer::Mat;
 
 /// A point mass of the cloud.
@@ -68,7 +68,18 @@ pub struct Invariants {
     pub l1: Vec<Vec3>,
     /// M_ee (m × m), kg.
     pub mee: Mat<f64>,
+    /// J2's symmetric parts ½ (J2_ab + J2_abᵀ) by component (xx, yy, zz, xy, xz, yz), each an
+    /// m × m array (row a, column b; symmetric in a and b, since J2_ba = J2_abᵀ): the
+    /// quadratic terms of [`Invariants::at_into`] as six matrix–vector products over
+    /// contiguous rows.
+    j2_sym: [Vec<f64>; 6],
+    /// L1_ab's components x, y, z, each an m × m array (row a, column b; antisymmetric in a
+    /// and b, L1_ba = −L1_ab, exactly as summed: m f_b × f_a = −m f_a × f_b in floating point).
+    l1_parts: [Vec<f64>; 3],
 }
+
+/// The component order of [`Mat3::symmetric`]: (row, column) of xx, yy, zz, xy, xz, yz.
+const SYMMETRIC: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
 
 /// The η-dependent invariants at one η.
 #[derive(Debug, Clone, Default)]
@@ -103,6 +114,8 @@ impl Invariants {
             l0: vec![Vec3::ZERO; m],
             l1: vec![Vec3::ZERO; m * m],
             mee: Mat::zeros(m, m),
+            j2_sym: Default::default(),
+            l1_parts: Default::default(),
         };
         for p in points {
             let (mp, r) = (p.mass, p.position);
@@ -131,7 +144,24 @@ impl Invariants {
                 }
             }
         }
+        inv.j2_sym = SYMMETRIC.map(|(r, c)| {
+            inv.j2
+                .iter()
+                .map(|x| 0.5 * (x.get(r, c) + x.get(c, r)))
+                .collect()
+        });
+        inv.l1_parts = [0, 1, 2].map(|i| inv.l1.iter().map(|x| x.get(i)).collect());
         inv
+    }
+
+    /// Σ_b L1_ab x_b for row a, = −Σ_b L1_ba x_b (antisymmetry): one contiguous row.
+    fn l1_row(&self, a: usize, x: &[f64]) -> Vec3 {
+        let m = self.modes;
+        Vec3(
+            self.l1_parts
+                .each_ref()
+                .map(|p| dot4(&p[a * m..(a + 1) * m], x)),
+        )
     }
 
     /// s(η), J(η), L(η) and ∂J/∂η.
@@ -142,42 +172,35 @@ impl Invariants {
     }
 
     /// [`Invariants::at`] into `out` (its vectors reused: no allocation once sized). With
-    /// K_a = Σ_b J2_ab η_b (J2_ba = J2_abᵀ, so Σ_b J2_abᵀ η_b = K_aᵀ):
-    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a η_a (J1_a + K_a),
-    ///   L_b = L₀_b + Σ_a L1_ab η_a,   ∂J/∂η_a = J1_a + K_a + K_aᵀ,
-    /// 9 m² multiply-adds for the quadratic terms, element by element on the 3×3 arrays (the
-    /// generic `Mat3` operators go through `array::map`, which is not inlined).
+    /// K_a = Σ_b J2_ab η_b and its symmetric part K̂_a = Σ_b ½ (J2_ab + J2_abᵀ) η_b
+    /// (J2_ba = J2_abᵀ, so Σ_ab η_a η_b J2_ab is symmetric and equals Σ_a η_a K̂_a):
+    ///   s = s₀ + Σ_a S_a η_a,   J = J₀ + Σ_a η_a (J1_a + K̂_a),
+    ///   L_b = L₀_b + Σ_a L1_ab η_a = L₀_b − Σ_a L1_ba η_a,   ∂J/∂η_a = J1_a + 2 K̂_a,
+    /// 6 m² + 3 m² multiply-adds for the quadratic terms, as dot products over contiguous rows
+    /// (`j2_sym`, `l1_parts`).
     pub fn at_into(&self, eta: &[f64], out: &mut AtShape) {
         let m = self.modes;
         let mut s = self.s0;
         let mut j = self.j0.0;
-        out.l.clear();
-        out.l.extend_from_slice(&self.l0);
         out.dj.clear();
         for a in 0..m {
             let ea = eta[a];
             s = s + self.s[a] * ea;
-            let mut k = [[0.0; 3]; 3];
-            for (jab, eb) in self.j2[a * m..(a + 1) * m].iter().zip(eta) {
-                for r in 0..3 {
-                    for c in 0..3 {
-                        k[r][c] += jab.0[r][c] * eb;
-                    }
-                }
-            }
+            let row = a * m..(a + 1) * m;
+            let k = Mat3::symmetric(self.j2_sym.each_ref().map(|p| dot4(&p[row.clone()], eta))).0;
             let j1 = &self.j1[a].0;
             let mut dj = [[0.0; 3]; 3];
             for r in 0..3 {
                 for c in 0..3 {
                     j[r][c] += (j1[r][c] + k[r][c]) * ea;
-                    dj[r][c] = j1[r][c] + (k[r][c] + k[c][r]);
+                    dj[r][c] = j1[r][c] + 2.0 * k[r][c];
                 }
             }
             out.dj.push(Mat3(dj));
-            for (lb, l1) in out.l.iter_mut().zip(&self.l1[a * m..(a + 1) * m]) {
-                *lb = *lb + *l1 * ea;
-            }
         }
+        out.l.clear();
+        out.l
+            .extend((0..m).map(|b| self.l0[b] - self.l1_row(b, eta)));
         out.s = s;
         out.j = Mat3(j);
     }
@@ -189,16 +212,10 @@ impl Invariants {
         out
     }
 
-    /// [`Invariants::l_rate`] into `out` (resized to m).
+    /// [`Invariants::l_rate`] into `out` (resized to m): L̇_b = −Σ_a L1_ba η̇_a.
     pub fn l_rate_into(&self, eta_dot: &[f64], out: &mut Vec<Vec3>) {
-        let m = self.modes;
         out.clear();
-        out.resize(m, Vec3::ZERO);
-        for a in 0..m {
-            for b in 0..m {
-                out[b] = out[b] + self.l1[a * m + b] * eta_dot[a];
-            }
-        }
+        out.extend((0..self.modes).map(|b| -self.l1_row(b, eta_dot)));
     }
 
     /// S η̇.
@@ -251,4 +268,103 @@ pub fn combine(columns: &[Vec3], x: &[f64]) -> Vec3 {
         .iter()
         .zip(x)
         .fold(Vec3::ZERO, |acc, (c, xi)| acc + *c * *xi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small cloud: three points and a rotary inertia, three modes.
+    fn cloud() -> (Vec<MassPoint>, Vec<RotaryPoint>) {
+        let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+        let points = vec![
+            MassPoint {
+                mass: 2.0,
+                position: v(1.0, 0.5, -0.3),
+                shapes: vec![v(0.1, 0.2, 0.3), v(-0.2, 0.1, 0.05), v(0.0, 0.3, -0.1)],
+            },
+            MassPoint {
+                mass: 3.5,
+                position: v(-0.4, 2.0, 0.7),
+                shapes: vec![v(0.3, -0.1, 0.2), v(0.05, 0.4, -0.2), v(0.1, 0.1, 0.1)],
+            },
+            MassPoint {
+                mass: 1.2,
+                position: v(0.2, -1.1, 1.5),
+                shapes: vec![v(-0.1, 0.0, 0.4), v(0.2, -0.3, 0.1), v(0.3, 0.2, 0.0)],
+            },
+        ];
+        let rotary = vec![RotaryPoint {
+            inertia: Mat3::symmetric([0.5, 0.7, 0.9, 0.1, -0.05, 0.02]),
+            rotations: vec![v(0.01, 0.02, 0.0), v(0.0, -0.03, 0.01), v(0.02, 0.0, 0.01)],
+        }];
+        (points, rotary)
+    }
+
+    /// s(η), J(η), L(η) and ∂J/∂η from the invariants against the cloud summed directly at
+    /// the deformed positions ρ_p = r_p + Φ_p η (second formulation: J = Σ m ρ̃ᵀρ̃ + Σ I_s,
+    /// L_j = Σ m ρ × Φ_pj + Σ I_s Ψ_sj, ∂J/∂η by central differences of that sum), and
+    /// L̇ against L's own η-derivative along η̇.
+    #[test]
+    fn the_invariants_at_a_shape_equal_the_deformed_clouds_sums() {
+        let (points, rotary) = cloud();
+        let inv = Invariants::of_cloud(3, &points, &rotary);
+        let direct = |eta: &[f64]| {
+            let (mut s, mut j) = (Vec3::ZERO, Mat3::ZERO);
+            let mut l = vec![Vec3::ZERO; 3];
+            for p in &points {
+                let rho = p.position + combine(&p.shapes, eta);
+                s = s + rho * p.mass;
+                j = j + skew_t_skew(rho, rho) * p.mass;
+                for (lj, f) in l.iter_mut().zip(&p.shapes) {
+                    *lj = *lj + rho.cross(*f) * p.mass;
+                }
+            }
+            for r in &rotary {
+                j = j + r.inertia;
+                for (lj, psi) in l.iter_mut().zip(&r.rotations) {
+                    *lj = *lj + r.inertia.apply(*psi);
+                }
+            }
+            (s, j, l)
+        };
+        let eta = [0.3, -0.7, 0.45];
+        let at = inv.at(&eta);
+        let (s, j, l) = direct(&eta);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + b.abs());
+        for i in 0..3 {
+            assert!(close(at.s.get(i), s.get(i)));
+            for c in 0..3 {
+                assert!(close(at.j.get(i, c), j.get(i, c)), "J {i}{c}");
+            }
+            for (a, b) in at.l.iter().zip(&l) {
+                assert!(close(a.get(i), b.get(i)), "L");
+            }
+        }
+        for a in 0..3 {
+            let h = 1e-5;
+            let (mut up, mut down) = (eta, eta);
+            up[a] += h;
+            down[a] -= h;
+            let dj = (direct(&up).1 - direct(&down).1) * (0.5 / h);
+            for r in 0..3 {
+                for c in 0..3 {
+                    // J is quadratic in η: the central difference is exact up to rounding.
+                    assert!((at.dj[a].get(r, c) - dj.get(r, c)).abs() < 1e-9, "dJ {a}");
+                }
+            }
+        }
+        let eta_dot = [0.2, 0.1, -0.4];
+        let rate = inv.l_rate(&eta_dot);
+        let h = 1e-6;
+        let up: Vec<f64> = eta.iter().zip(&eta_dot).map(|(e, d)| e + h * d).collect();
+        let down: Vec<f64> = eta.iter().zip(&eta_dot).map(|(e, d)| e - h * d).collect();
+        let (lu, ld) = (direct(&up).2, direct(&down).2);
+        for b in 0..3 {
+            let d = (lu[b] - ld[b]) * (0.5 / h);
+            for i in 0..3 {
+                assert!((rate[b].get(i) - d.get(i)).abs() < 1e-9, "L̇ {b}");
+            }
+        }
+    }
 }

@@ -44,6 +44,25 @@ pub trait OdeSystem {
     }
     /// The first [`OdeSystem::kinematic`] components of f(t, y) into `dy` (of that length).
     fn rhs_kinematic(&self, _t: f64, _y: &[f64], _dy: &mut [f64]) {}
+    /// The index of the first speed when [`OdeSystem::rhs_speeds`] evaluates changes of the
+    /// speeds more cheaply than [`OdeSystem::rhs`] would (a mechanical system whose mass
+    /// matrix depends on the positions alone factors it once for all of them); None (the
+    /// default) otherwise. A Jacobian by differences takes the speeds' columns from there.
+    fn speed_offset(&self) -> Option<usize> {
+        None
+    }
+    /// f(t, y') for each (component, value) of `changes` in turn, y' being y with that
+    /// component set to that value, into the rows of `out` (each of y's length). By default
+    /// one [`OdeSystem::rhs`] each; a system with a [`OdeSystem::speed_offset`] shares the
+    /// configuration's work between the changes of its speeds, and gives the same values.
+    fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[(usize, f64)], out: &mut [Vec<f64>]) {
+        let mut yp = y.to_vec();
+        for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
+            yp[c] = v;
+            self.rhs(t, &yp, dy);
+            yp[c] = y[c];
+        }
+    }
     /// Quantities the exact flow conserves, and on which components of y they depend
     /// linearly (none by default): a free-floating spacecraft's linear and angular momentum,
     /// linear in the hub's velocity and rate. A stepper that does not conserve them by

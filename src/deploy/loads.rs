@@ -297,6 +297,19 @@ impl Engine for Coupled {
     fn rhs_kinematic(&self, y: &[f64], dy: &mut [f64]) {
         self.hub_kinematics(y, dy);
     }
+    fn speed_offset(&self) -> Option<usize> {
+        Some(Coupled::positions(self))
+    }
+    fn rhs_speeds(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        changes: &[(usize, f64)],
+        out: &mut [Vec<f64>],
+    ) {
+        self.rhs_captured_speeds(y, free, captured, changes, out);
+    }
     fn invariants(&self, y: &[f64]) -> Vec<f64> {
         if self.hub_dof() < 6 {
             return Vec::new();

@@ -172,16 +172,18 @@ const B: [f64; STAGES] = [
 /// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y): column c from the step
 /// JAC_DELTA·max(|y_c|, 1), as represented. The columns of the kinematic components
 /// ([`OdeSystem::kinematic`]) come from their rows alone (zero below); the others cost one
-/// evaluation each.
+/// evaluation each, the speeds' ([`OdeSystem::speed_offset`]) through
+/// [`OdeSystem::rhs_speeds`], which shares their configuration's work.
 pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64]) -> Mat<f64> {
     let n = y.len();
     let k = sys.kinematic();
+    let speeds = sys.speed_offset().unwrap_or(n).clamp(k, n);
     let mut j = Mat::zeros(n, n);
     let mut yp = y.to_vec();
     let mut fp = vec![0.0; n];
-    for c in 0..n {
-        let d = JAC_DELTA * y[c].abs().max(1.0);
-        yp[c] = y[c] + d;
+    let perturbed = |c: usize| y[c] + JAC_DELTA * y[c].abs().max(1.0);
+    for c in 0..speeds {
+        yp[c] = perturbed(c);
         let d = yp[c] - y[c]; // the representable step
         let rows = if c < k {
             sys.rhs_kinematic(t, &yp, &mut fp[..k]);
@@ -194,6 +196,15 @@ pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64
             j[(r, c)] = (fp[r] - f0[r]) / d;
         }
         yp[c] = y[c];
+    }
+    let changes: Vec<(usize, f64)> = (speeds..n).map(|c| (c, perturbed(c))).collect();
+    let mut out = vec![vec![0.0; n]; changes.len()];
+    sys.rhs_speeds(t, y, &changes, &mut out);
+    for (&(c, v), fp) in changes.iter().zip(&out) {
+        let d = v - y[c];
+        for r in 0..n {
+            j[(r, c)] = (fp[r] - f0[r]) / d;
+        }
     }
     j
 }

@@ -85,6 +85,28 @@ pub(crate) trait Engine {
     }
     /// Their rows of dy/dt.
     fn rhs_kinematic(&self, _y: &[f64], _dy: &mut [f64]) {}
+    /// The first speed, when [`Engine::rhs_speeds`] shares the configuration's work
+    /// ([`OdeSystem::speed_offset`]); None by default.
+    fn speed_offset(&self) -> Option<usize> {
+        None
+    }
+    /// dy/dt at y with one speed changed, per change ([`OdeSystem::rhs_speeds`]); one
+    /// [`Engine::rhs`] each by default.
+    fn rhs_speeds(
+        &self,
+        y: &[f64],
+        free: &[bool],
+        captured: &[bool],
+        changes: &[(usize, f64)],
+        out: &mut [Vec<f64>],
+    ) {
+        let mut yp = y.to_vec();
+        for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
+            yp[c] = v;
+            self.rhs(&yp, free, captured, dy);
+            yp[c] = y[c];
+        }
+    }
     /// Conserved quantities ([`OdeSystem::invariants`]); none by default.
     fn invariants(&self, _y: &[f64]) -> Vec<f64> {
         Vec::new()
@@ -268,6 +290,13 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     }
     fn rhs_kinematic(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
         self.engine.rhs_kinematic(y, dy);
+    }
+    fn speed_offset(&self) -> Option<usize> {
+        self.engine.speed_offset()
+    }
+    fn rhs_speeds(&self, _t: f64, y: &[f64], changes: &[(usize, f64)], out: &mut [Vec<f64>]) {
+        self.engine
+            .rhs_speeds(y, &self.free, &self.captured, changes, out);
     }
     fn invariants(&self, y: &[f64]) -> Vec<f64> {
         self.engine.invariants(y)

@@ -460,6 +460,29 @@ fn linear_time_elimination_equals_the_dense_solve() {
                         "{panels} panels, {motion} hub, {sync:?}, pattern {pattern}: u̇[{k}] {a} vs dense {b}"
                     );
                 }
+                // The speeds' changes of a Jacobian by differences share the configuration's
+                // work (`rhs_captured_speeds`): each row is `rhs_captured` at its own state,
+                // bit for bit; a position among them (α_1, first) is evaluated on its own.
+                let changes: Vec<(usize, f64)> = std::iter::once(c.alpha_offset())
+                    .chain(np..y.len())
+                    .map(|c| (c, y[c] + 1e-3 * rand()))
+                    .collect();
+                let mut rows = vec![vec![0.0; y.len()]; changes.len()];
+                c.rhs_captured_speeds(&y, &free, &captured, &changes, &mut rows);
+                for (&(k, v), row) in changes.iter().zip(&rows) {
+                    let mut yk = y.clone();
+                    yk[k] = v;
+                    let mut alone = vec![0.0; y.len()];
+                    c.rhs_captured(&yk, &free, &captured, &mut alone);
+                    let same = row
+                        .iter()
+                        .zip(&alone)
+                        .all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(
+                        same,
+                        "{panels} panels, {motion} hub, {sync:?}, pattern {pattern}: component {k}"
+                    );
+                }
                 checked += 1;
             }
         }
