@@ -664,16 +664,15 @@ impl Ringing {
         for (w_old, v_old) in self.modes.w.iter().zip(&self.modes.v) {
             // |w_oldᵀ v_k| |w_kᵀ v_old|: 1 for an unchanged mode, and independent of how the
             // eigensolver splits the scale between v_k and w_k (only w_kᵀ v_k = 1 is fixed).
-            let overlap = |k: usize| (dot(w_old, &next.v[k]) * dot(&next.w[k], v_old)).norm();
-            let k = (0..k_count)
+            // (Each candidate's two products once: (k, w_oldᵀ v_k, w_kᵀ v_old).)
+            let (k, one_sided, back) = (0..k_count)
                 .filter(|&k| !taken[k])
-                .max_by(|&p, &q| overlap(p).total_cmp(&overlap(q)))?;
+                .map(|k| (k, dot(w_old, &next.v[k]), dot(&next.w[k], v_old)))
+                .max_by(|p, q| (p.1 * p.2).norm().total_cmp(&(q.1 * q.2).norm()))?;
             taken[k] = true;
             // The symmetric (trapezoidal) transport: the scale g of v_new = ṽ/g, w_new = w̃g
             // with (w_old + w_new)ᵀ(v_new − v_old) = 0, i.e. g² = (w_oldᵀṽ)/(w̃ᵀv_old);
             // second order in the step, where w_oldᵀ v_new = 1 alone is first.
-            let one_sided = dot(w_old, &next.v[k]);
-            let back = dot(&next.w[k], v_old);
             if (one_sided * back).norm() < MIN_OVERLAP {
                 return None;
             }
