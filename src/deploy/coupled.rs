@@ -38,6 +38,7 @@ use super::attitude::{self, Quaternion};
 use super::base::BaseModel;
 use super::chain::{Chain, P2};
 use super::inertia::{combine, AtShape};
+use super::integrator::{Change, Tie};
 use crate::math::{dot4, Mat3, Vec3};
 use crate::structure::HubMotion;
 use faer::{Mat, Side};
@@ -252,6 +253,25 @@ impl Coupled {
         }
     }
 
+    /// With an ideal cable and some hinge free ([`OdeSystem`](super::integrator::OdeSystem)
+    /// ties): the opening angles and their rates, each along the cable's speed vector
+    /// r = (1, 2, 2, …) (α − α(0) = r (α₁ − α₁(0)), α̇ = r α̇₁); none otherwise.
+    pub fn cable_ties(&self, free: &[bool]) -> Vec<Tie> {
+        let n = self.panels();
+        if !self.cable_speed(free) || n < 2 {
+            return Vec::new();
+        }
+        let r: Vec<f64> = (0..n).map(|i| if i == 0 { 1.0 } else { 2.0 }).collect();
+        let (a, s) = (self.alpha_offset(), self.positions() + self.rate_offset());
+        [a, s]
+            .into_iter()
+            .map(|first| Tie {
+                components: (first..first + n).collect(),
+                direction: r.clone(),
+            })
+            .collect()
+    }
+
     /// The cable's loop matrix C ((N − 1) × N).
     fn cable_rows(&self) -> Vec<Vec<f64>> {
         Self::cable_law(self.panels())
@@ -326,7 +346,7 @@ impl Coupled {
     /// What depends on the positions alone (η and α): the invariants at η, the hinge frame,
     /// B, the chain's mass blocks M₁₁ and M₁₂ and outboard sums, M_bb (and the dense M when
     /// `dense`). The speeds' columns of a Jacobian by differences share it
-    /// ([`Coupled::rhs_speeds`]).
+    /// ([`Coupled::rhs_captured_speeds`]).
     fn assemble_configuration(&self, y: &[f64], ws: &mut Workspace, dense: bool) {
         let s = self.view(y);
         let base = &self.base;
@@ -1180,18 +1200,18 @@ impl Coupled {
         });
     }
 
-    /// [`Coupled::rhs_captured`] at y with one speed changed, for each (component, value) of
-    /// `changes` in turn, into the rows of `out`: the configuration's work (the invariants at
-    /// η, B, M_bb, the chain's mass blocks and the reduced matrix's factorisation, about two
-    /// thirds of an evaluation) is done once for all of them. Each row equals
-    /// [`Coupled::rhs_captured`] at its state, bit for bit. A change of a position (not a
-    /// speed) is evaluated on its own.
+    /// [`Coupled::rhs_captured`] at y with some speeds changed, for each change of `changes`
+    /// in turn ((component, value) pairs), into the rows of `out`: the configuration's work
+    /// (the invariants at η, B, M_bb, the chain's mass blocks and the reduced matrix's
+    /// factorisation, about two thirds of an evaluation) is done once for all of them. Each
+    /// row equals [`Coupled::rhs_captured`] at its state, bit for bit. A change that moves a
+    /// position (not only speeds) is evaluated on its own.
     pub fn rhs_captured_speeds(
         &self,
         y: &[f64],
         free: &[bool],
         captured: &[bool],
-        changes: &[(usize, f64)],
+        changes: &[Change],
         out: &mut [Vec<f64>],
     ) {
         let np = self.positions();
@@ -1199,9 +1219,11 @@ impl Coupled {
         WORKSPACE.with_borrow_mut(|(ws, sw)| {
             self.assemble_configuration(y, ws, false);
             let mut factored = self.factor_chain(ws, sw, free);
-            for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
-                yp[c] = v;
-                if c < np {
+            for (change, dy) in changes.iter().zip(out.iter_mut()) {
+                for &(c, v) in change {
+                    yp[c] = v;
+                }
+                if change.iter().any(|&(c, _)| c < np) {
                     self.assemble_configuration(&yp, ws, false);
                     let f = self.factor_chain(ws, sw, free);
                     self.rhs_at_configuration(&yp, free, captured, f, ws, sw, dy);
@@ -1211,7 +1233,9 @@ impl Coupled {
                 } else {
                     self.rhs_at_configuration(&yp, free, captured, factored, ws, sw, dy);
                 }
-                yp[c] = y[c];
+                for &(c, _) in change {
+                    yp[c] = y[c];
+                }
             }
         });
     }

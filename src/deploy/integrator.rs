@@ -24,6 +24,53 @@
 use super::adiabatic::RingingStep;
 use std::sync::Arc;
 
+/// A change of some components of y: (component, new value) pairs.
+pub type Change = Vec<(usize, f64)>;
+
+/// Components that move together ([`OdeSystem::ties`]): y_k − y_k(0) = d_k s along the
+/// direction d, whose first entry, the representative's, is 1.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tie {
+    /// The components, the representative first.
+    pub components: Vec<usize>,
+    /// d, one entry per component, d₀ = 1.
+    pub direction: Vec<f64>,
+}
+
+/// The columns a Jacobian of `sys` by differences at y takes ([`OdeSystem::ties`]): each
+/// untied component c with the change y_c + step(c), and each tie's representative c with
+/// the change of all its components y_k + d_k step(c) (first in the change: c's own). The
+/// other tied components' columns are zero.
+pub(crate) fn difference_columns(
+    sys: &dyn OdeSystem,
+    y: &[f64],
+    step: impl Fn(usize) -> f64,
+) -> Vec<(usize, Change)> {
+    let ties = sys.ties();
+    let mut tie_of = vec![None; y.len()];
+    for (i, tie) in ties.iter().enumerate() {
+        for (p, &k) in tie.components.iter().enumerate() {
+            tie_of[k] = Some((i, p));
+        }
+    }
+    (0..y.len())
+        .filter_map(|c| match tie_of[c] {
+            None => Some((c, vec![(c, y[c] + step(c))])),
+            Some((i, 0)) => {
+                let (h, tie) = (step(c), &ties[i]);
+                let change = tie
+                    .components
+                    .iter()
+                    .zip(&tie.direction)
+                    .map(|(&k, &d)| (k, y[k] + d * h))
+                    .collect();
+                Some((c, change))
+            }
+            Some(_) => None,
+        })
+        .collect()
+}
+
 /// One right-hand side y' = f(t, y).
 pub trait OdeSystem {
     /// Writes f(t, y) into `dy`.
@@ -55,13 +102,27 @@ pub trait OdeSystem {
     /// component set to that value, into the rows of `out` (each of y's length). By default
     /// one [`OdeSystem::rhs`] each; a system with a [`OdeSystem::speed_offset`] shares the
     /// configuration's work between the changes of its speeds, and gives the same values.
-    fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[(usize, f64)], out: &mut [Vec<f64>]) {
+    fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[Change], out: &mut [Vec<f64>]) {
         let mut yp = y.to_vec();
-        for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
-            yp[c] = v;
+        for (change, dy) in changes.iter().zip(out.iter_mut()) {
+            for &(c, v) in change {
+                yp[c] = v;
+            }
             self.rhs(t, &yp, dy);
-            yp[c] = y[c];
+            for &(c, _) in change {
+                yp[c] = y[c];
+            }
         }
+    }
+    /// Components the flow moves together along a fixed direction: an ideal constraint
+    /// linear in them (an ideal cable's opening angles, α − α(0) ∥ r, and their rates,
+    /// α̇ ∥ r) keeps y − y(0) in the tangent space T they leave. None by default. A Jacobian
+    /// by differences takes one column per tie, along its direction, and leaves the other
+    /// tied columns zero: J P with P the projection onto T that reads each tie from its first
+    /// component. J P equals J on T and maps into T, where every stage and step of the
+    /// integrators stays, and its eigenproblem has T's dimension ([`Tie`]).
+    fn ties(&self) -> Vec<Tie> {
+        Vec::new()
     }
     /// Quantities the exact flow conserves, and on which components of y they depend
     /// linearly (none by default): a free-floating spacecraft's linear and angular momentum,

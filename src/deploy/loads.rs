@@ -22,6 +22,7 @@ use super::attitude;
 use super::chain::{Hinge, P2};
 use super::coupled::{Coupled, Eval, Solution, Synchronisation};
 use super::inertia::combine;
+use super::integrator::{Change, Tie};
 use super::run::{Engine, Impulses};
 use super::{BodySample, Sample};
 use crate::math::Vec3;
@@ -305,10 +306,13 @@ impl Engine for Coupled {
         y: &[f64],
         free: &[bool],
         captured: &[bool],
-        changes: &[(usize, f64)],
+        changes: &[Change],
         out: &mut [Vec<f64>],
     ) {
         self.rhs_captured_speeds(y, free, captured, changes, out);
+    }
+    fn ties(&self, free: &[bool]) -> Vec<Tie> {
+        self.cable_ties(free)
     }
     fn invariants(&self, y: &[f64]) -> Vec<f64> {
         if self.hub_dof() < 6 {
@@ -457,6 +461,137 @@ mod tests {
         for (l, ((f, m), (fd, md))) in loads.iter().zip(&direct).enumerate() {
             let err = (*f - *fd).dot(*f - *fd).sqrt() + (*m - *md).dot(*m - *md).sqrt();
             assert!(err <= 1e-12 * scale, "hinge {l}: {err} against {scale}");
+        }
+    }
+
+    /// The ideal cable's ties ([`Coupled::cable_ties`]): the Jacobian by differences takes
+    /// one column per tie, J P. On the cable's tangent space T (α − α(0) and α̇ along
+    /// r = (1, 2, 2, …)) it equals the Jacobian of one column per component, and both equal
+    /// f's directional derivative by central differences (the independent truth) to 1e-6;
+    /// every column of J P lies in T (its α and α̇ rows along r), and the other tied
+    /// columns are zero. 12 panels, free hub, 8 base modes, at a deformed, moving state on
+    /// the cable's manifold.
+    #[test]
+    fn the_cable_ties_jacobian_equals_the_full_one_on_the_cable_tangent_space() {
+        use crate::deploy::integrator::{OdeSystem, Tie};
+        use crate::deploy::rosenbrock::forward_jacobian;
+        struct Sys<'a>(&'a Coupled, bool);
+        impl OdeSystem for Sys<'_> {
+            fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+                let n = self.0.panels();
+                self.0.rhs_captured(y, &vec![true; n], &vec![false; n], dy);
+            }
+            fn kinematic(&self) -> usize {
+                self.0.kinematic_positions()
+            }
+            fn rhs_kinematic(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+                self.0.hub_kinematics(y, dy);
+            }
+            fn speed_offset(&self) -> Option<usize> {
+                Some(Coupled::positions(self.0))
+            }
+            fn rhs_speeds(&self, _t: f64, y: &[f64], changes: &[Change], out: &mut [Vec<f64>]) {
+                let n = self.0.panels();
+                self.0
+                    .rhs_captured_speeds(y, &vec![true; n], &vec![false; n], changes, out);
+            }
+            fn ties(&self) -> Vec<Tie> {
+                if self.1 {
+                    self.0.cable_ties(&vec![true; self.0.panels()])
+                } else {
+                    Vec::new()
+                }
+            }
+        }
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed.toml");
+        let src = std::fs::read_to_string(path)
+            .unwrap()
+            .replace("panels = 3", "panels = 12");
+        let sc = Scenario::from_toml_str(&src, path).unwrap();
+        let d = Deployment {
+            base: BaseKind::Flexible { modes: Some(8) },
+            synchronisation: Synchronisation::IdealCable,
+            ..sc.deployment.clone().unwrap()
+        };
+        let c = d.coupled(&sc.structure).unwrap();
+        let (np, n, nb) = (Coupled::positions(&c), c.panels(), c.rate_offset());
+        let (a0, s0) = (c.alpha_offset(), np + nb);
+        let r: Vec<f64> = (0..n).map(|i| if i == 0 { 1.0 } else { 2.0 }).collect();
+        let wave = |i: usize, k: f64| (i as f64 * k).sin();
+        // On the manifold: α = α(0) + 0.3 r, α̇ = 0.05 r; everything else deformed and moving.
+        let mut y = c.initial_state();
+        for i in 0..y.len() {
+            if (a0..a0 + n).contains(&i) {
+                y[i] += 0.3 * r[i - a0];
+            } else if (s0..s0 + n).contains(&i) {
+                y[i] = 0.05 * r[i - s0];
+            } else {
+                y[i] += 0.01 * wave(i, 2.3);
+            }
+        }
+        let q = &mut y[3..7];
+        let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        q.iter_mut().for_each(|x| *x /= norm);
+        let mut f0 = vec![0.0; y.len()];
+        Sys(&c, false).rhs(0.0, &y, &mut f0);
+        let full = forward_jacobian(&Sys(&c, false), 0.0, &y, &f0);
+        let tied = forward_jacobian(&Sys(&c, true), 0.0, &y, &f0);
+        let len = y.len();
+        for trial in 0..3 {
+            // A tangent vector: any base and hub components, the chain's along r.
+            let t: Vec<f64> = (0..len)
+                .map(|i| {
+                    let x = wave(i + 7 * trial, 1.7);
+                    if (a0..a0 + n).contains(&i) {
+                        r[i - a0] * wave(trial, 3.1)
+                    } else if (s0..s0 + n).contains(&i) {
+                        r[i - s0] * wave(trial + 5, 0.9)
+                    } else {
+                        x
+                    }
+                })
+                .collect();
+            let apply = |j: &faer::Mat<f64>| -> Vec<f64> {
+                (0..len)
+                    .map(|i| (0..len).map(|k| j[(i, k)] * t[k]).sum())
+                    .collect()
+            };
+            let e = 1e-6;
+            let (mut up, mut down) = (vec![0.0; len], vec![0.0; len]);
+            let shifted =
+                |s: f64| -> Vec<f64> { y.iter().zip(&t).map(|(a, b)| a + s * b).collect() };
+            Sys(&c, false).rhs(0.0, &shifted(e), &mut up);
+            Sys(&c, false).rhs(0.0, &shifted(-e), &mut down);
+            let truth: Vec<f64> = up
+                .iter()
+                .zip(&down)
+                .map(|(a, b)| (a - b) / (2.0 * e))
+                .collect();
+            let scale = truth.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            for (what, j) in [("full", &full), ("tied", &tied)] {
+                let jt = apply(j);
+                for (i, (a, b)) in jt.iter().zip(&truth).enumerate() {
+                    assert!(
+                        (a - b).abs() <= 1e-6 * scale,
+                        "{what}, trial {trial}, row {i}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+        for col in 0..len {
+            for first in [a0, s0] {
+                let rep = tied[(first, col)];
+                for i in 1..n {
+                    let x = tied[(first + i, col)];
+                    assert!(
+                        (x - r[i] * rep).abs() <= 1e-9 * rep.abs().max(1.0),
+                        "column {col} leaves T"
+                    );
+                    if col == first + i {
+                        assert!((0..len).all(|row| tied[(row, col)] == 0.0));
+                    }
+                }
+            }
         }
     }
 }

@@ -31,7 +31,7 @@
 //! [`super::integrator`]: the run needs every accepted step's continuous extension as a
 //! value, restarts at every latch, and byte-identical results.
 
-use super::integrator::{DenseStep, OdeSystem};
+use super::integrator::{difference_columns, Change, DenseStep, OdeSystem};
 use faer::Mat;
 
 const STAGES: usize = 8;
@@ -173,7 +173,9 @@ const B: [f64; STAGES] = [
 /// JAC_DELTA·max(|y_c|, 1), as represented. The columns of the kinematic components
 /// ([`OdeSystem::kinematic`]) come from their rows alone (zero below); the others cost one
 /// evaluation each, the speeds' ([`OdeSystem::speed_offset`]) through
-/// [`OdeSystem::rhs_speeds`], which shares their configuration's work.
+/// [`OdeSystem::rhs_speeds`], which shares their configuration's work. A tie
+/// ([`OdeSystem::ties`]) is differenced along its direction, in its first component's
+/// column ([`difference_columns`]).
 pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64]) -> Mat<f64> {
     let n = y.len();
     let k = sys.kinematic();
@@ -181,29 +183,37 @@ pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64
     let mut j = Mat::zeros(n, n);
     let mut yp = y.to_vec();
     let mut fp = vec![0.0; n];
-    let perturbed = |c: usize| y[c] + JAC_DELTA * y[c].abs().max(1.0);
-    for c in 0..speeds {
-        yp[c] = perturbed(c);
-        let d = yp[c] - y[c]; // the representable step
-        let rows = if c < k {
+    let columns = difference_columns(sys, y, |c| JAC_DELTA * y[c].abs().max(1.0));
+    // The representable step of column c: its component's change.
+    let step = |c: usize, change: &Change| change[0].1 - y[c];
+    let (moving, speed_columns): (Vec<_>, Vec<_>) =
+        columns.into_iter().partition(|(c, _)| *c < speeds);
+    for (c, change) in &moving {
+        for &(i, v) in change {
+            yp[i] = v;
+        }
+        let rows = if *c < k {
             sys.rhs_kinematic(t, &yp, &mut fp[..k]);
             k
         } else {
             sys.rhs(t, &yp, &mut fp);
             n
         };
+        let d = step(*c, change);
         for r in 0..rows {
-            j[(r, c)] = (fp[r] - f0[r]) / d;
+            j[(r, *c)] = (fp[r] - f0[r]) / d;
         }
-        yp[c] = y[c];
+        for &(i, _) in change {
+            yp[i] = y[i];
+        }
     }
-    let changes: Vec<(usize, f64)> = (speeds..n).map(|c| (c, perturbed(c))).collect();
+    let changes: Vec<Change> = speed_columns.iter().map(|(_, ch)| ch.clone()).collect();
     let mut out = vec![vec![0.0; n]; changes.len()];
     sys.rhs_speeds(t, y, &changes, &mut out);
-    for (&(c, v), fp) in changes.iter().zip(&out) {
-        let d = v - y[c];
+    for ((c, change), fp) in speed_columns.iter().zip(&out) {
+        let d = step(*c, change);
         for r in 0..n {
-            j[(r, c)] = (fp[r] - f0[r]) / d;
+            j[(r, *c)] = (fp[r] - f0[r]) / d;
         }
     }
     j

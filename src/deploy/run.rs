@@ -7,7 +7,7 @@
 use super::adiabatic::Adiabatic;
 use super::chain::{Chain, Hinge, PlanarHub, P2};
 use super::events::{self, Crossing};
-use super::integrator::{DenseStep, Dopri5, OdeSystem};
+use super::integrator::{Change, DenseStep, Dopri5, OdeSystem, Tie};
 use super::peaks::PeakTracker;
 use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
@@ -97,15 +97,24 @@ pub(crate) trait Engine {
         y: &[f64],
         free: &[bool],
         captured: &[bool],
-        changes: &[(usize, f64)],
+        changes: &[Change],
         out: &mut [Vec<f64>],
     ) {
         let mut yp = y.to_vec();
-        for (&(c, v), dy) in changes.iter().zip(out.iter_mut()) {
-            yp[c] = v;
+        for (change, dy) in changes.iter().zip(out.iter_mut()) {
+            for &(c, v) in change {
+                yp[c] = v;
+            }
             self.rhs(&yp, free, captured, dy);
-            yp[c] = y[c];
+            for &(c, _) in change {
+                yp[c] = y[c];
+            }
         }
+    }
+    /// The components the motion ties for the hinges flagged free ([`OdeSystem::ties`]);
+    /// none by default.
+    fn ties(&self, _free: &[bool]) -> Vec<Tie> {
+        Vec::new()
     }
     /// Conserved quantities ([`OdeSystem::invariants`]); none by default.
     fn invariants(&self, _y: &[f64]) -> Vec<f64> {
@@ -294,9 +303,12 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     fn speed_offset(&self) -> Option<usize> {
         self.engine.speed_offset()
     }
-    fn rhs_speeds(&self, _t: f64, y: &[f64], changes: &[(usize, f64)], out: &mut [Vec<f64>]) {
+    fn rhs_speeds(&self, _t: f64, y: &[f64], changes: &[Change], out: &mut [Vec<f64>]) {
         self.engine
             .rhs_speeds(y, &self.free, &self.captured, changes, out);
+    }
+    fn ties(&self) -> Vec<Tie> {
+        self.engine.ties(&self.free)
     }
     fn invariants(&self, y: &[f64]) -> Vec<f64> {
         self.engine.invariants(y)

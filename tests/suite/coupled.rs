@@ -462,16 +462,23 @@ fn linear_time_elimination_equals_the_dense_solve() {
                 }
                 // The speeds' changes of a Jacobian by differences share the configuration's
                 // work (`rhs_captured_speeds`): each row is `rhs_captured` at its own state,
-                // bit for bit; a position among them (α_1, first) is evaluated on its own.
-                let changes: Vec<(usize, f64)> = std::iter::once(c.alpha_offset())
-                    .chain(np..y.len())
+                // bit for bit; a position among them (α_1, first) is evaluated on its own,
+                // and one change moves every opening rate at once (a cable tie's column).
+                let rates: Vec<(usize, f64)> = (np + nb..y.len())
                     .map(|c| (c, y[c] + 1e-3 * rand()))
+                    .collect();
+                let changes: Vec<Vec<(usize, f64)>> = std::iter::once(c.alpha_offset())
+                    .chain(np..y.len())
+                    .map(|c| vec![(c, y[c] + 1e-3 * rand())])
+                    .chain([rates])
                     .collect();
                 let mut rows = vec![vec![0.0; y.len()]; changes.len()];
                 c.rhs_captured_speeds(&y, &free, &captured, &changes, &mut rows);
-                for (&(k, v), row) in changes.iter().zip(&rows) {
+                for (k, (change, row)) in changes.iter().zip(&rows).enumerate() {
                     let mut yk = y.clone();
-                    yk[k] = v;
+                    for &(i, v) in change {
+                        yk[i] = v;
+                    }
                     let mut alone = vec![0.0; y.len()];
                     c.rhs_captured(&yk, &free, &captured, &mut alone);
                     let same = row
@@ -480,7 +487,7 @@ fn linear_time_elimination_equals_the_dense_solve() {
                         .all(|(a, b)| a.to_bits() == b.to_bits());
                     assert!(
                         same,
-                        "{panels} panels, {motion} hub, {sync:?}, pattern {pattern}: component {k}"
+                        "{panels} panels, {motion} hub, {sync:?}, pattern {pattern}: change {k}"
                     );
                 }
                 checked += 1;
