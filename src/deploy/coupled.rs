@@ -1203,7 +1203,7 @@ impl Coupled {
     /// [`Coupled::rhs_captured`] at y with some speeds changed, for each change of `changes`
     /// in turn ((component, value) pairs), into the rows of `out`: the configuration's work
     /// (the invariants at η, B, M_bb, the chain's mass blocks and the reduced matrix's
-    /// factorisation, about two thirds of an evaluation) is done once for all of them. Each
+    /// factorisation, most of an evaluation's time) is done once for all of them. Each
     /// row equals [`Coupled::rhs_captured`] at its state, bit for bit. A change that moves a
     /// position (not only speeds) is evaluated on its own.
     pub fn rhs_captured_speeds(
