@@ -900,6 +900,55 @@ fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>
     (out, evaluations, share)
 }
 
+/// F₂ of [`mean_forcing`] for the pairs flagged in `ringing.forced`, by sampling the phases
+/// instead of differencing each pair: with the K pairs given the frequencies k_j = j + 1 and
+/// M = 2K + 1 samples ψ_j(s) = 2π k_j s / M, δ(s) = Σ_j 2|a_j| (p_j cos ψ_j − q_j sin ψ_j)
+/// (the ringing at those phases) and F₂ ≈ (1/M) Σ_s [f(y + δ(s)) − f(y)]. The mean over the
+/// samples of a product of two of the trigonometric terms is their mean over all phases,
+/// since no sum or difference of two frequencies (at most 2K) is a multiple of M: the first
+/// order vanishes and the second is ½ Σ_j |2a_j|² ½ (D²f[p_j, p_j] + D²f[q_j, q_j]), F₂ exactly.
+/// Third-order terms whose frequencies add up to M alias into it, at the ringing's relative
+/// size against the second order (the per-pair differences cancel the odd orders). M + 1
+/// evaluations where the per-pair differences take 4K + 1: the steps' F₂; the split keeps
+/// the per-pair form for the pairs' shares. Returns F₂ and the evaluations.
+fn mean_forcing_sampled(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>, usize) {
+    let n = ys.len();
+    let pairs: Vec<(f64, &Vec<c64>)> = ringing
+        .a
+        .iter()
+        .zip(ringing.modes.v.iter().zip(&ringing.modes.lam))
+        .zip(&ringing.forced)
+        .filter(|((_, (_, l)), forced)| l.im > 0.0 && **forced)
+        .map(|((a, (v, _)), _)| (2.0 * a.norm(), v))
+        .collect();
+    let mut out = vec![0.0; n];
+    if pairs.is_empty() {
+        return (out, 0);
+    }
+    let mut f0 = vec![0.0; n];
+    sys.rhs(0.0, ys, &mut f0);
+    let m = 2 * pairs.len() + 1;
+    let (mut fp, mut y) = (vec![0.0; n], vec![0.0; n]);
+    for s in 0..m {
+        y.copy_from_slice(ys);
+        for (j, (amp, v)) in pairs.iter().enumerate() {
+            let psi = 2.0 * std::f64::consts::PI * ((j + 1) * s % m) as f64 / m as f64;
+            let (sn, cs) = psi.sin_cos();
+            for (yi, vi) in y.iter_mut().zip(v.iter()) {
+                *yi += amp * (vi.re * cs - vi.im * sn);
+            }
+        }
+        sys.rhs(0.0, &y, &mut fp);
+        for ((o, p), q) in out.iter_mut().zip(&fp).zip(&f0) {
+            *o += p - q;
+        }
+    }
+    for o in &mut out {
+        *o /= m as f64;
+    }
+    (out, m + 1)
+}
+
 /// The system for Rodas5P: the full Jacobian (module docs), taken from `cached` when the step
 /// starts where the last one ended (the adiabatic step differences it there anyway), else by
 /// Rodas5P's own differences.
@@ -1393,7 +1442,7 @@ impl Adiabatic {
         if let Some(f_start) = self.forcing.take() {
             if !self.fresh {
                 // F₂ at the step's end, from the ringing there; its slope for the next step.
-                let (f_end, count, _) = mean_forcing(sys, &self.ys, ringing);
+                let (f_end, count) = mean_forcing_sampled(sys, &self.ys, ringing);
                 self.extra_evaluations += count;
                 let h = *t - t0;
                 self.forcing_slope = (h > 0.0).then(|| {
@@ -1431,6 +1480,94 @@ mod tests {
             dy[2] = -w1 * w1 * y[0] + 50.0 * s * y[1] + 0.3;
             dy[3] = -w2 * w2 * y[1] + 50.0 * s * y[0];
             dy[4] = SIGMA;
+        }
+    }
+
+    /// The ringing's mean forcing on a system with a quadratic f (so that both forms are exact
+    /// but for rounding): f(y) = L y + Q(y, y), D²f[x, x] = 2 Q(x, x), and for pairs
+    /// a_j, v_j = p_j + i q_j (with their conjugates) F₂ = Σ_j |a_j|² 2 (Q(p_j, p_j) + Q(q_j, q_j)).
+    /// The per-pair differences and the phase sampling both give it, for three pairs; a pair
+    /// not flagged forced is left out of both.
+    #[test]
+    fn the_mean_forcing_by_pairs_and_by_phase_sampling_equals_the_closed_form() {
+        struct Quadratic;
+        fn q(x: &[f64]) -> [f64; 4] {
+            [
+                0.7 * x[0] * x[1] - 0.2 * x[2] * x[2],
+                1.3 * x[0] * x[0] + 0.4 * x[1] * x[3],
+                -0.5 * x[3] * x[3] + 0.9 * x[0] * x[2],
+                0.6 * x[1] * x[2] - 1.1 * x[0] * x[3],
+            ]
+        }
+        impl OdeSystem for Quadratic {
+            fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {
+                let quad = q(y);
+                for i in 0..4 {
+                    dy[i] = 0.3 * y[(i + 1) % 4] - 2.0 * y[i] + quad[i];
+                }
+            }
+        }
+        let c = |re: f64, im: f64| c64::new(re, im);
+        let vs = [
+            vec![c(0.3, 0.1), c(-0.2, 0.4), c(0.5, 0.0), c(0.1, -0.3)],
+            vec![c(-0.1, 0.2), c(0.3, 0.3), c(0.0, -0.4), c(0.2, 0.1)],
+            vec![c(0.25, -0.15), c(0.05, 0.1), c(-0.3, 0.2), c(0.4, 0.05)],
+        ];
+        let amps = [c(0.02, 0.01), c(-0.015, 0.005), c(0.01, -0.02)];
+        let (mut lam, mut v, mut a) = (Vec::new(), Vec::new(), Vec::new());
+        for (j, (vj, aj)) in vs.iter().zip(&amps).enumerate() {
+            let l = c(-0.1, 50.0 * (j + 1) as f64);
+            lam.extend([l, l.conj()]);
+            v.extend([vj.clone(), vj.iter().map(|x| x.conj()).collect()]);
+            a.extend([*aj, aj.conj()]);
+        }
+        let w = v.clone(); // not read by the forcing
+        let mut ringing = Ringing {
+            modes: FastModes { lam, v, w },
+            a,
+            history: Vec::new(),
+            forced: vec![true; 6],
+        };
+        let ys = [0.1, -0.2, 0.3, 0.05];
+        let closed = |forced: &[bool]| -> Vec<f64> {
+            let mut out = vec![0.0; 4];
+            for (j, (vj, aj)) in vs.iter().zip(&amps).enumerate() {
+                if !forced[2 * j] {
+                    continue;
+                }
+                let p: Vec<f64> = vj.iter().map(|x| x.re).collect();
+                let qq: Vec<f64> = vj.iter().map(|x| x.im).collect();
+                for (o, (x, y)) in out.iter_mut().zip(q(&p).iter().zip(q(&qq))) {
+                    *o += aj.norm_sqr() * 2.0 * (x + y);
+                }
+            }
+            out
+        };
+        for drop in [None, Some(1)] {
+            if let Some(j) = drop {
+                ringing.forced[2 * j] = false;
+                ringing.forced[2 * j + 1] = false;
+            }
+            let truth = closed(&ringing.forced);
+            let scale = truth.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+            let (pairs, _, _) = mean_forcing(&Quadratic, &ys, &ringing);
+            let (sampled, evaluations) = mean_forcing_sampled(&Quadratic, &ys, &ringing);
+            let k = 3 - usize::from(drop.is_some());
+            assert_eq!(evaluations, 2 * k + 2);
+            for i in 0..4 {
+                assert!(
+                    (pairs[i] - truth[i]).abs() <= 1e-9 * scale,
+                    "pairs {i}: {} vs {}",
+                    pairs[i],
+                    truth[i]
+                );
+                assert!(
+                    (sampled[i] - truth[i]).abs() <= 1e-9 * scale,
+                    "sampled {i}: {} vs {}",
+                    sampled[i],
+                    truth[i]
+                );
+            }
         }
     }
 

@@ -414,11 +414,8 @@ mod tests {
     use crate::deploy::Deployment;
     use crate::scenario::Scenario;
 
-    /// The tip-to-root recursion of [`Coupled::hinge_loads`] equals the definition
-    ///   F_l = Σ_{i≥l} m_i a_i,   M_l = Σ_{i≥l} (c_i − h_l) × m_i a_i + I_i ε_i + ω_i × I_i ω_i
-    /// summed directly, on 12 panels at an arbitrary turning, deforming state.
-    #[test]
-    fn hinge_loads_by_recursion_equal_the_outboard_sums() {
+    /// The seed's spacecraft with 12 panels and 8 base modes, free hub.
+    fn twelve_panels(synchronisation: Synchronisation) -> Coupled {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed.toml");
         let src = std::fs::read_to_string(path)
             .unwrap()
@@ -426,10 +423,18 @@ mod tests {
         let sc = Scenario::from_toml_str(&src, path).unwrap();
         let d = Deployment {
             base: BaseKind::Flexible { modes: Some(8) },
-            synchronisation: crate::deploy::coupled::Synchronisation::None,
+            synchronisation,
             ..sc.deployment.clone().unwrap()
         };
-        let c = d.coupled(&sc.structure).unwrap();
+        d.coupled(&sc.structure).unwrap()
+    }
+
+    /// The tip-to-root recursion of [`Coupled::hinge_loads`] equals the definition
+    ///   F_l = Σ_{i≥l} m_i a_i,   M_l = Σ_{i≥l} (c_i − h_l) × m_i a_i + I_i ε_i + ω_i × I_i ω_i
+    /// summed directly, on 12 panels at an arbitrary turning, deforming state.
+    #[test]
+    fn hinge_loads_by_recursion_equal_the_outboard_sums() {
+        let c = twelve_panels(Synchronisation::None);
         let mut y = c.initial_state();
         let np = c.positions();
         for (i, v) in y.iter_mut().enumerate() {
@@ -503,17 +508,7 @@ mod tests {
                 }
             }
         }
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/seed.toml");
-        let src = std::fs::read_to_string(path)
-            .unwrap()
-            .replace("panels = 3", "panels = 12");
-        let sc = Scenario::from_toml_str(&src, path).unwrap();
-        let d = Deployment {
-            base: BaseKind::Flexible { modes: Some(8) },
-            synchronisation: Synchronisation::IdealCable,
-            ..sc.deployment.clone().unwrap()
-        };
-        let c = d.coupled(&sc.structure).unwrap();
+        let c = twelve_panels(Synchronisation::IdealCable);
         let (np, n, nb) = (Coupled::positions(&c), c.panels(), c.rate_offset());
         let (a0, s0) = (c.alpha_offset(), np + nb);
         let r: Vec<f64> = (0..n).map(|i| if i == 0 { 1.0 } else { 2.0 }).collect();
