@@ -27,7 +27,7 @@ use crate::warning::Warning;
 use base::{BaseKind, BaseModel};
 use chain::{Chain, PlanarHub, P2};
 use coupled::{Coupled, Synchronisation};
-pub use integrator::{DenseStep, OdeSystem};
+pub use integrator::{Change, DenseStep, OdeSystem, Tie};
 pub use rosenbrock::Rodas5P;
 pub use swing::SwingBack;
 
