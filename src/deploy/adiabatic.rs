@@ -50,7 +50,9 @@
 //! slow mechanism on a linear, weakly excited elastic base), built from faer's eigensolver
 //! and the crate's own Rodas5P.
 
-use super::integrator::{difference_columns, Change, DenseStep, OdeSystem, Tie};
+use super::integrator::{
+    difference_columns, differenced_columns, Change, DenseStep, OdeSystem, Tie,
+};
 use super::rosenbrock::{forward_jacobian, Rodas5P};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
@@ -445,7 +447,8 @@ fn newton(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes, rates: &[c64]) -> V
 /// coordinates over Δ gives the rates g_j, and the point is projected again with
 /// w_jᵀ f(y_s) = g_j. (At release, where the slow motion starts from rest, g_j = 0 and this
 /// changes nothing; after an impact or a capture it keeps the residual ringing at O(ε²).)
-fn project(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes) -> Vec<f64> {
+/// Returns y_s and the rates g_j.
+fn project(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes) -> (Vec<f64>, Vec<c64>) {
     let n = y.len();
     let zero = vec![c64::new(0.0, 0.0); modes.lam.len()];
     let y0 = newton(sys, y, modes, &zero);
@@ -464,23 +467,30 @@ fn project(sys: &dyn OdeSystem, y: &[f64], modes: &FastModes) -> Vec<f64> {
         .iter()
         .map(|w| (dot_real(w, &y1) - dot_real(w, &y0)) / dt)
         .collect();
-    newton(sys, &y0, modes, &rates)
+    let ys = newton(sys, &y0, modes, &rates);
+    (ys, rates)
 }
 
 /// A ringing mode is carried while some component of it exceeds this fraction of the error
 /// tolerance (atol + rtol |y_i|); below, its part of the state is dropped at the split.
 const NEGLIGIBLE_RINGING: f64 = 1e-2;
 
-/// Whether the projection of y onto the slow manifold along `modes`, `ys`, is one: finite,
-/// f there not larger than at y (max norms, with a factor 10 of room), and the fast
-/// components of f it solved for, w_jᵀ f, no larger than at y (beyond 1e-6 of f's size:
-/// the Newton iteration reduced what it set out to reduce). The projection takes the
+/// Whether the projection of y onto the slow manifold along `modes`, `ys` with the rates
+/// `rates` ([`project`]), is one: finite, f there not larger than at y (max norms, with a
+/// factor 10 of room), and the residual of what it solved for, max_j |w_jᵀ f − g_j|, no
+/// larger than at y (beyond 1e-6 of f's size: the Newton iteration reduced what it set out
+/// to reduce). The projection takes the
 /// ringing's accelerations out of f; when the Newton iteration with J frozen diverges
 /// instead (seen with 50 panels closing on the straight latch configuration, where a new
 /// pair crosses the threshold: f from 6e3 to 1e33; or f ten times larger and its fast
 /// components 18 times, the hub moved 1 cm), the caller keeps the state whole and Rodas5P
 /// integrates it, ringing and all.
-fn projected(sys: &dyn OdeSystem, y: &[f64], ys: &[f64], modes: &FastModes) -> bool {
+fn projected(
+    sys: &dyn OdeSystem,
+    y: &[f64],
+    (ys, rates): &(Vec<f64>, Vec<c64>),
+    modes: &FastModes,
+) -> bool {
     if !ys.iter().all(|v| v.is_finite()) {
         return false;
     }
@@ -490,7 +500,8 @@ fn projected(sys: &dyn OdeSystem, y: &[f64], ys: &[f64], modes: &FastModes) -> b
         let fast = modes
             .w
             .iter()
-            .map(|w| dot_real(w, &f).norm())
+            .zip(rates)
+            .map(|(w, g)| (dot_real(w, &f) - g).norm())
             .fold(0.0, f64::max);
         (max_norm(&f), fast)
     };
@@ -590,7 +601,7 @@ impl Phase {
 pub fn slow_manifold(sys: &dyn OdeSystem, y: &[f64], threshold: f64) -> Option<(Vec<f64>, usize)> {
     let modes = fast_modes(&central_jacobian(sys, y), sys.kinematic(), threshold, None)?;
     let count = modes.lam.len();
-    Some((project(sys, y, &modes), count))
+    Some((project(sys, y, &modes).0, count))
 }
 
 /// The share of the largest mode's acceleration amplitude below which a carried mode does
@@ -907,8 +918,10 @@ fn mean_forcing(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>
 /// samples of a product of two of the trigonometric terms is their mean over all phases,
 /// since no sum or difference of two frequencies (at most 2K) is a multiple of M: the first
 /// order vanishes and the second is ½ Σ_j |2a_j|² ½ (D²f[p_j, p_j] + D²f[q_j, q_j]), F₂ exactly.
-/// Third-order terms whose frequencies add up to M alias into it, at the ringing's relative
-/// size against the second order (the per-pair differences cancel the odd orders). M + 1
+/// Third-order terms alias into it: triads of frequencies with k_a ± k_b ± k_c = 0 (1 + 1 − 2,
+/// 1 + 2 − 3, …, for any K ≥ 2), whose mean over all phases vanishes but not over the
+/// samples, and those adding up to M. The error is O(|δ|³), the ringing's relative size
+/// against F₂ (the per-pair differences cancel the odd orders). M + 1
 /// evaluations where the per-pair differences take 4K + 1: the steps' F₂; the split keeps
 /// the per-pair form for the pairs' shares. Returns F₂ and the evaluations.
 fn mean_forcing_sampled(sys: &dyn OdeSystem, ys: &[f64], ringing: &Ringing) -> (Vec<f64>, usize) {
@@ -1021,6 +1034,8 @@ pub struct Adiabatic {
     forcing: Option<Vec<f64>>,
     /// F₂'s rate over the last step, per second (None right after a split).
     forcing_slope: Option<Vec<f64>>,
+    /// `forcing` is the split's (per-pair differences), not a step end's (phase sampling).
+    forcing_from_split: bool,
     /// The conserved quantities at the first split ([`OdeSystem::invariants`]), restored
     /// after every step; empty when the system has none.
     target: Vec<f64>,
@@ -1054,6 +1069,7 @@ impl Adiabatic {
             jacobian: None,
             forcing: None,
             forcing_slope: None,
+            forcing_from_split: false,
             fast_count: 0,
             target: Vec::new(),
             invariant_jacobian: None,
@@ -1082,7 +1098,7 @@ impl Adiabatic {
     fn forward(&mut self, sys: &dyn OdeSystem, y: &[f64]) -> Mat<f64> {
         let mut f0 = vec![0.0; y.len()];
         sys.rhs(0.0, y, &mut f0);
-        self.extra_evaluations += y.len() - sys.kinematic() + 1;
+        self.extra_evaluations += differenced_columns(sys, y) + 1;
         forward_jacobian(sys, 0.0, y, &f0)
     }
 
@@ -1102,8 +1118,9 @@ impl Adiabatic {
         self.ringing = None;
         self.forcing = None;
         self.forcing_slope = None;
+        self.forcing_from_split = false;
         self.ys = y.to_vec();
-        self.extra_evaluations += 2 * (y.len() - sys.kinematic());
+        self.extra_evaluations += 2 * differenced_columns(sys, y);
         let Some(at_y) = fast_modes(
             &central_jacobian(sys, y),
             sys.kinematic(),
@@ -1117,12 +1134,13 @@ impl Adiabatic {
         }
         let count = at_y.lam.len();
         self.fast_count = count;
-        let ys = project(sys, y, &at_y);
+        let projection = project(sys, y, &at_y);
         self.extra_evaluations += 3 * PROJECTION_ITERATIONS + 3;
-        if !projected(sys, y, &ys, &at_y) {
+        if !projected(sys, y, &projection, &at_y) {
             return;
         }
-        self.extra_evaluations += 2 * (y.len() - sys.kinematic());
+        let ys = projection.0;
+        self.extra_evaluations += 2 * differenced_columns(sys, y);
         let Some(all) = fast_modes(
             &central_jacobian(sys, &ys),
             sys.kinematic(),
@@ -1171,14 +1189,15 @@ impl Adiabatic {
             cached: None,
             forcing: Some(&f2),
         };
-        let ys = project(&forced, y, &all);
+        let projection = project(&forced, y, &all);
         self.extra_evaluations += 3 * PROJECTION_ITERATIONS + 3;
-        if !projected(&forced, y, &ys, &all) {
+        if !projected(&forced, y, &projection, &all) {
             // Keep the unforced split, without F₂.
             self.forcing = None;
             self.ringing = Some(ringing);
             return;
         }
+        let ys = projection.0;
         let delta: Vec<f64> = y.iter().zip(&ys).map(|(a, b)| a - b).collect();
         // The pairs dropped from F₂ stay dropped; a mode excited only now is differenced.
         let dropped = ringing.unforced_modes();
@@ -1188,6 +1207,7 @@ impl Adiabatic {
         });
         self.ys = ys;
         self.forcing = self.ringing.is_some().then_some(f2);
+        self.forcing_from_split = self.forcing.is_some();
     }
 
     /// The ringing δ on the fast `modes`, its amplitudes c_j = w_jᵀ δ, keeping only the modes
@@ -1445,7 +1465,11 @@ impl Adiabatic {
                 let (f_end, count) = mean_forcing_sampled(sys, &self.ys, ringing);
                 self.extra_evaluations += count;
                 let h = *t - t0;
-                self.forcing_slope = (h > 0.0).then(|| {
+                // After a split F₂(t0) came from the per-pair differences
+                // (`mean_forcing`, for the pairs' shares): no slope between the two
+                // estimators, the next step holds F₂(t1).
+                let split_forcing = std::mem::take(&mut self.forcing_from_split);
+                self.forcing_slope = (h > 0.0 && !split_forcing).then(|| {
                     f_end
                         .iter()
                         .zip(&f_start)

@@ -203,7 +203,10 @@ impl Coupled {
     }
 
     /// The state at release: at rest, undeformed, hub at the origin, α(0) and α̇(0) of the
-    /// hinges.
+    /// hinges. With an ideal cable the rates are the root hinge's along the cable's speed
+    /// vector r = (1, 2, 2, …) exactly (the scenario accepts them to 1e-9 of the law): the
+    /// state starts on the cable's manifold, whose tangent space the Jacobian's ties
+    /// ([`Coupled::cable_ties`]) assume.
     pub fn initial_state(&self) -> Vec<f64> {
         let (np, ns) = (self.positions(), self.speeds());
         let mut y = vec![0.0; np + ns];
@@ -211,9 +214,15 @@ impl Coupled {
             y[3] = 1.0;
         }
         let (a, r) = (self.alpha_offset(), np + self.rate_offset());
+        let cable = self.sync == Synchronisation::IdealCable;
+        let root_rate = self.chain.hinges.first().map_or(0.0, |h| h.initial_rate);
         for (i, h) in self.chain.hinges.iter().enumerate() {
             y[a + i] = h.initial_angle;
-            y[r + i] = h.initial_rate;
+            y[r + i] = match (cable, i) {
+                (true, 0) => root_rate,
+                (true, _) => 2.0 * root_rate,
+                (false, _) => h.initial_rate,
+            };
         }
         y
     }

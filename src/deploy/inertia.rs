@@ -60,12 +60,12 @@ pub struct Invariants {
     pub j0: Mat3,
     /// J1_j, kg·m.
     pub j1: Vec<Mat3>,
-    /// J2_jk (index j·m + k), kg.
-    pub j2: Vec<Mat3>,
+    /// J2_jk (index j·m + k), kg (private: `j2_sym` is derived from it).
+    j2: Vec<Mat3>,
     /// Columns of L₀, kg·m.
     pub l0: Vec<Vec3>,
-    /// L1_j's columns (index j·m + k), kg.
-    pub l1: Vec<Vec3>,
+    /// L1_j's columns (index j·m + k), kg (private: `l1_parts` is derived from it).
+    l1: Vec<Vec3>,
     /// M_ee (m × m), kg.
     pub mee: Mat<f64>,
     /// J2's symmetric parts ½ (J2_ab + J2_abᵀ) by component (xx, yy, zz, xy, xz, yz), each an

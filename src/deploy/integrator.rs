@@ -71,6 +71,16 @@ pub(crate) fn difference_columns(
         .collect()
 }
 
+/// The evaluations of f a Jacobian of `sys` by differences at y takes, one a side: its
+/// [`difference_columns`] that are not kinematic.
+pub(crate) fn differenced_columns(sys: &dyn OdeSystem, y: &[f64]) -> usize {
+    let k = sys.kinematic();
+    difference_columns(sys, y, |_| 0.0)
+        .iter()
+        .filter(|(c, _)| *c >= k)
+        .count()
+}
+
 /// One right-hand side y' = f(t, y).
 pub trait OdeSystem {
     /// Writes f(t, y) into `dy`.

@@ -31,7 +31,7 @@
 //! [`super::integrator`]: the run needs every accepted step's continuous extension as a
 //! value, restarts at every latch, and byte-identical results.
 
-use super::integrator::{difference_columns, Change, DenseStep, OdeSystem};
+use super::integrator::{difference_columns, differenced_columns, Change, DenseStep, OdeSystem};
 use faer::Mat;
 
 const STAGES: usize = 8;
@@ -274,7 +274,7 @@ impl Rodas5P {
 
     /// ∂f/∂y at (t, y) by forward differences, f0 = f(t, y).
     fn jacobian(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> Mat<f64> {
-        self.evaluations += y.len() - sys.kinematic();
+        self.evaluations += differenced_columns(sys, y);
         forward_jacobian(sys, t, y, &self.f0)
     }
 
