@@ -71,6 +71,25 @@ pub(crate) fn difference_columns(
         .collect()
 }
 
+/// `eval` at y with each change of `changes` applied in turn, into the rows of `out`.
+pub(crate) fn each_change(
+    y: &[f64],
+    changes: &[Change],
+    out: &mut [Vec<f64>],
+    mut eval: impl FnMut(&[f64], &mut [f64]),
+) {
+    let mut yp = y.to_vec();
+    for (change, dy) in changes.iter().zip(out.iter_mut()) {
+        for &(c, v) in change {
+            yp[c] = v;
+        }
+        eval(&yp, dy);
+        for &(c, _) in change {
+            yp[c] = y[c];
+        }
+    }
+}
+
 /// The evaluations of f a Jacobian of `sys` by differences at y takes, one a side: its
 /// [`difference_columns`] that are not kinematic.
 pub(crate) fn differenced_columns(sys: &dyn OdeSystem, y: &[f64]) -> usize {
@@ -113,16 +132,7 @@ pub trait OdeSystem {
     /// one [`OdeSystem::rhs`] each; a system with a [`OdeSystem::speed_offset`] shares the
     /// configuration's work between the changes of its speeds, and gives the same values.
     fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[Change], out: &mut [Vec<f64>]) {
-        let mut yp = y.to_vec();
-        for (change, dy) in changes.iter().zip(out.iter_mut()) {
-            for &(c, v) in change {
-                yp[c] = v;
-            }
-            self.rhs(t, &yp, dy);
-            for &(c, _) in change {
-                yp[c] = y[c];
-            }
-        }
+        each_change(y, changes, out, |yp, dy| self.rhs(t, yp, dy));
     }
     /// Components the flow moves together along a fixed direction: an ideal constraint
     /// linear in them (an ideal cable's opening angles, α − α(0) ∥ r, and their rates,

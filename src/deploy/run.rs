@@ -7,7 +7,7 @@
 use super::adiabatic::Adiabatic;
 use super::chain::{Chain, Hinge, PlanarHub, P2};
 use super::events::{self, Crossing};
-use super::integrator::{Change, DenseStep, Dopri5, OdeSystem, Tie};
+use super::integrator::{each_change, Change, DenseStep, Dopri5, OdeSystem, Tie};
 use super::peaks::PeakTracker;
 use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
@@ -100,16 +100,7 @@ pub(crate) trait Engine {
         changes: &[Change],
         out: &mut [Vec<f64>],
     ) {
-        let mut yp = y.to_vec();
-        for (change, dy) in changes.iter().zip(out.iter_mut()) {
-            for &(c, v) in change {
-                yp[c] = v;
-            }
-            self.rhs(&yp, free, captured, dy);
-            for &(c, _) in change {
-                yp[c] = y[c];
-            }
-        }
+        each_change(y, changes, out, |yp, dy| self.rhs(yp, free, captured, dy));
     }
     /// The components the motion ties for the hinges flagged free ([`OdeSystem::ties`]);
     /// none by default.
