@@ -156,6 +156,20 @@ pub trait OdeSystem {
     fn invariant_coordinates(&self) -> Vec<usize> {
         Vec::new()
     }
+    /// Per-component factors s_i on the error tolerance: a stepper that honours them
+    /// ([`Rodas5P`](super::Rodas5P)) measures y_i's error against s_i (atol + rtol |y_i|).
+    /// None (the default) for all 1. A modal velocity's factor is its mode's ω, so that its
+    /// tolerance carries the energy of its displacement's (½ δη̇² = ½ ω² δη²).
+    fn tolerance_scales(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// The tolerance factors for a run along the system's slow manifold, where its fast
+    /// velocities are quasi-static (the adiabatic integrator's slow run, which passes them
+    /// on as its [`tolerance_scales`](Self::tolerance_scales)); None (the default) for all 1.
+    /// A run that resolves the fast modes keeps the common tolerance.
+    fn slow_tolerance_scales(&self) -> Option<Vec<f64>> {
+        None
+    }
 }
 
 const C2: f64 = 1.0 / 5.0;

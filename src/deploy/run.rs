@@ -115,6 +115,11 @@ pub(crate) trait Engine {
     fn invariant_coordinates(&self) -> Vec<usize> {
         Vec::new()
     }
+    /// The tolerance's factors per component for the slow run
+    /// ([`OdeSystem::slow_tolerance_scales`]); none by default.
+    fn slow_tolerance_scales(&self) -> Option<Vec<f64>> {
+        None
+    }
     /// Load magnitudes whose peaks the run tracks at every step ([`super::peaks`]); none by
     /// default.
     fn load_magnitudes(&self, _y: &[f64], _free: &[bool], _captured: &[bool]) -> Vec<f64> {
@@ -306,6 +311,9 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     }
     fn invariant_coordinates(&self) -> Vec<usize> {
         self.engine.invariant_coordinates()
+    }
+    fn slow_tolerance_scales(&self) -> Option<Vec<f64>> {
+        self.engine.slow_tolerance_scales()
     }
 }
 
