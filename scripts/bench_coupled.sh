@@ -2,7 +2,9 @@
 # Prints the figures of docs/bench-coupled.md (issue 11): the coupled deployment (the array on
 # the flexible free-floating base, explicit DOPRI5) of the seed example and of a 50-panel wing,
 # the cost of one right-hand side against panels N and base modes m with the fitted growth
-# exponents, and the steps against the tolerance. Criterion runs with quick settings (10
+# exponents, the steps against the tolerance, and the whole runs with the adiabatic integrator
+# against the issue's targets (scripts/bench_adiabatic.py for the whole processes, criterion's
+# group coupled_adiabatic for the library call). Criterion runs with quick settings (10
 # samples, short measurement); its own output is kept in target/bench-coupled.log.
 #   COUPLED_FULL=1 scripts/bench_coupled.sh   also runs every whole deployment once (about
 #                                             15 minutes: they end at the 1e6-step limit).
@@ -24,6 +26,9 @@ for cell in 3,20 50,30 100,0; do
     b=$(GLIBC_TUNABLES=glibc.malloc.trim_threshold=268435456 COUPLED_RHS_LOOP=$cell "$exe" | sed 's/.*: \([0-9.]* µs\).*/\1/')
     echo "  N,m = $cell: $a / $b"
 done
+
+cargo build --release --quiet
+python3 scripts/bench_adiabatic.py
 
 cargo bench --bench coupled > target/bench-coupled.log 2> /dev/null
 # Criterion's own estimates (on-CPU time) are in the log; the table:
