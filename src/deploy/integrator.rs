@@ -232,6 +232,12 @@ impl DenseStep {
         }
     }
 
+    /// Adds δ (t − t0)/h to component k of the extension: a correction made at the step's
+    /// end, spread over the step so that the extension stays continuous there.
+    pub(crate) fn add_linear(&mut self, k: usize, delta: f64) {
+        self.r[1][k] += delta;
+    }
+
     /// Adds the adiabatic stepper's ringing over this step to the extension.
     pub(crate) fn add_ringing(&mut self, ringing: Arc<RingingStep>) {
         self.ringing = Some(ringing);
