@@ -18,7 +18,8 @@ RUNS = 5
 
 
 def adiabatic(src: str, modes: int) -> str:
-    src = re.sub(r"\nbase_modes = \d+", f"\nbase_modes = {modes}", src)
+    src, n = re.subn(r"\nbase_modes = \d+", f"\nbase_modes = {modes}", src)
+    assert n == 1, "one base_modes line"
     if "integrator = " not in src:
         src = src.replace("\ntolerance = 1e-8", '\ntolerance = 1e-8\nintegrator = "adiabatic"')
     assert f"base_modes = {modes}" in src and 'integrator = "adiabatic"' in src
@@ -33,8 +34,8 @@ def compliant(src: str, k: str, c: str) -> str:
 
 
 def scenarios() -> list:
-    seed = open("examples/seed.toml").read()
-    comp = open("examples/seed_compliant.toml").read()
+    seed = open("examples/seed.toml", encoding="utf-8").read()
+    comp = open("examples/seed_compliant.toml", encoding="utf-8").read()
     wide = seed
     for old, new in (
         ("bending = 8, torsion = 6, axial = 4", "bending = 16, torsion = 10, axial = 8"),
@@ -42,7 +43,8 @@ def scenarios() -> list:
     ):
         assert old in wide, old
         wide = wide.replace(old, new)
-    wide = re.sub(r"\[deployment.hinge\]\nstiffness = [0-9.e]+", "[deployment.hinge]\nstiffness = 1.0", wide)
+    wide, n = re.subn(r"\[deployment.hinge\]\nstiffness = [0-9.e]+", "[deployment.hinge]\nstiffness = 1.0", wide)
+    assert n == 1, "examples/seed.toml has one [deployment.hinge] stiffness"
     return [
         ("seed, 20 base modes, simulate (target 0.2 s)", "simulate", "seed20", adiabatic(seed, 20)),
         ("examples/seed_compliant.toml, simulate (target 0.5 s)", "simulate", "compliant1e5", comp),
@@ -65,11 +67,15 @@ def cpu_of(args: list) -> float:
 
 
 def main() -> int:
+    os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+    if not os.path.exists(EXE):
+        print(f"{EXE} is missing: run `cargo build --release` first", file=sys.stderr)
+        return 1
     os.makedirs("target", exist_ok=True)
     print(f"whole process, adiabatic integrator, tol 1e-8, CPU (min–max of {RUNS} runs):")
     for label, command, name, src in scenarios():
         path = f"target/bench-{name}.toml"
-        with open(path, "w") as f:
+        with open(path, "w", encoding="utf-8") as f:
             f.write(src)
         times = [cpu_of([EXE, command, path]) for _ in range(RUNS)]
         print(f"  {label}: {min(times):.3f}–{max(times):.3f} s")

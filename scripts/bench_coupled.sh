@@ -10,6 +10,7 @@
 #                                             15 minutes: they end at the 1e6-step limit).
 set -eu
 cd "$(dirname "$0")/.."
+mkdir -p target
 cargo bench --bench coupled --no-run 2> target/bench-coupled.build || {
     cat target/bench-coupled.build
     exit 1

@@ -225,12 +225,14 @@ fn fast_modes_and_growth(
         .filter(|&a| lam[a].re.abs() <= RINGING_DAMPING * lam[a].im.abs())
         .collect();
     order.sort_by(|&a, &b| lam[b].im.abs().total_cmp(&lam[a].im.abs()));
-    let take = count.unwrap_or_else(|| {
-        order
-            .iter()
-            .filter(|&&a| lam[a].im.abs() > threshold)
-            .count()
-    });
+    // Never a mode below the threshold: a whole decomposition at a step's end asks for as
+    // many as the split found, and where a carried mode has become heavily damped the next
+    // by |Im λ| could be a mechanism mode.
+    let above = order
+        .iter()
+        .filter(|&&a| lam[a].im.abs() > threshold)
+        .count();
+    let take = count.map_or(above, |c| c.min(above));
     let mut modes = FastModes {
         lam: Vec::with_capacity(take),
         v: Vec::with_capacity(take),
@@ -247,9 +249,12 @@ fn fast_modes_and_growth(
 
 /// The largest |Re λ| / |Im λ| of a ringing mode (about its damping ratio): a mode that
 /// decays faster is left to the slow run, whose L-stable steps damp it without resolving it
-/// (a compliant latch's mode, ζ ≈ 0.2), and one that grows is no small oscillation about the
-/// slow motion (the linearisation of a 50-panel accordion whipping straight, 2 ms before
-/// its latch: 31 ± 88i and 149 ± 93i among the base's modes).
+/// (a compliant latch's mode, ζ ≈ 0.2), and one that grows faster is no small oscillation
+/// about the slow motion (the linearisation of a 50-panel accordion whipping straight, 2 ms
+/// before its latch: 31 ± 88i and 149 ± 93i among the base's modes). A mode growing more
+/// slowly is carried, its growth in its phase θ = ∫ λ dt; a state where any mode grows
+/// faster than the threshold frequency is not split at all ([`Adiabatic::split`]), and a
+/// carried mode found growing that fast at a step's end sends the next step to a new split.
 const RINGING_DAMPING: f64 = 0.1;
 
 /// J's core: the rows and columns of the coordinates that feed the dynamics (all but the
@@ -422,6 +427,10 @@ fn track(
     }
     Some(out)
 }
+
+/// Steps integrated whole after a refused split before the split is tried again (a
+/// Jacobian by central differences and a whole decomposition each time).
+const RESPLIT_STEPS: usize = 16;
 
 /// The most carried mode pairs that are tracked ([`track`]); beyond, the whole
 /// decomposition is taken. An LU costs 1/25 of the decomposition at n = 24 and 52 and 1/19
@@ -994,6 +1003,10 @@ struct SlowSystem<'a> {
     cached: Option<&'a (Vec<f64>, Mat<f64>)>,
     /// The ringing's mean forcing, held over the step (`mean_forcing`).
     forcing: Option<&'a [f64]>,
+    /// On the slow manifold (the ringing split off): the error control takes the system's
+    /// [`OdeSystem::slow_tolerance_scales`]. A state integrated whole, its ringing resolved,
+    /// keeps the common tolerance.
+    on_manifold: bool,
 }
 
 impl OdeSystem for SlowSystem<'_> {
@@ -1023,7 +1036,9 @@ impl OdeSystem for SlowSystem<'_> {
         self.sys.ties()
     }
     fn tolerance_scales(&self) -> Option<Vec<f64>> {
-        self.sys.slow_tolerance_scales()
+        self.on_manifold
+            .then(|| self.sys.slow_tolerance_scales())
+            .flatten()
     }
     fn rhs_speeds(&self, t: f64, y: &[f64], changes: &[Change], out: &mut [Vec<f64>]) {
         self.sys.rhs_speeds(t, y, changes, out);
@@ -1055,6 +1070,10 @@ pub struct Adiabatic {
     ys: Vec<f64>,
     ringing: Option<Ringing>,
     fresh: bool,
+    /// Steps integrated whole since a refused split (eigensolver failure, a growing mode, a
+    /// failed projection): the ringing resolved by the slow run with the common tolerance.
+    /// None while the state is on its slow manifold, or has nothing fast to split off.
+    refused: Option<usize>,
     /// J at the end of the last step, where the next one starts: (y_s, J).
     jacobian: Option<(Vec<f64>, Mat<f64>)>,
     /// The ringing's mean forcing F₂ at the current step's start, when it is not negligible.
@@ -1093,6 +1112,7 @@ impl Adiabatic {
             ys: Vec::new(),
             ringing: None,
             fresh: true,
+            refused: None,
             jacobian: None,
             forcing: None,
             forcing_slope: None,
@@ -1148,6 +1168,8 @@ impl Adiabatic {
         self.forcing_slope = None;
         self.forcing_from_split = false;
         self.ys = y.to_vec();
+        // Refused unless it gets past the projection, or finds nothing fast.
+        self.refused = Some(0);
         self.extra_evaluations += 2 * differenced_columns(sys, y);
         let Some((at_y, growth)) = fast_modes_and_growth(
             &central_jacobian(sys, y),
@@ -1163,11 +1185,13 @@ impl Adiabatic {
         // 0.1 s, with a real eigenvalue ≈ 1/(t_latch − t)). Fast modes picked from such a
         // J mix the mechanism with the base's, and a projection along them moved the rate
         // (7.5 → 0.34 rad/s) and the energy (251.7 J → 14 or 387 J). The slow run then
-        // resolves the whole state until the growth has passed.
+        // resolves the whole state, and the split is tried again every
+        // [`RESPLIT_STEPS`] steps until the growth has passed.
         if growth > self.threshold {
             return;
         }
         if at_y.lam.is_empty() {
+            self.refused = None;
             return;
         }
         let count = at_y.lam.len();
@@ -1187,6 +1211,7 @@ impl Adiabatic {
         ) else {
             return;
         };
+        self.refused = None;
         let modes = all.clone();
         let delta: Vec<f64> = y.iter().zip(&ys).map(|(a, b)| a - b).collect();
         let Some(ringing) = self.excited(modes, &delta, &ys) else {
@@ -1226,6 +1251,7 @@ impl Adiabatic {
             sys,
             cached: None,
             forcing: Some(&f2),
+            on_manifold: true,
         };
         let projection = project(&forced, y, &all);
         self.extra_evaluations += 3 * PROJECTION_ITERATIONS + 3;
@@ -1450,6 +1476,7 @@ impl Adiabatic {
             sys,
             cached: self.jacobian.as_ref(),
             forcing: mean.as_deref(),
+            on_manifold: self.refused.is_none(),
         };
         if mean.is_some() || self.moved {
             self.slow.refresh_derivative(&full, t0, &self.ys);
@@ -1460,6 +1487,10 @@ impl Adiabatic {
         let n = y.len();
         if self.ringing.is_none() {
             self.jacobian = None;
+            if let Some(steps) = self.refused.as_mut() {
+                *steps += 1;
+                self.fresh = *steps >= RESPLIT_STEPS;
+            }
             return dense;
         }
         let count = self.fast_count;
@@ -1483,6 +1514,14 @@ impl Adiabatic {
             .flatten();
         let end =
             tracked.or_else(|| fast_modes(&j_end, sys.kinematic(), self.threshold, Some(count)));
+        if end
+            .as_ref()
+            .is_some_and(|e| e.lam.iter().any(|l| l.re > self.threshold))
+        {
+            // A carried mode grows as fast as the base rings: split afresh (where the
+            // growth refuses it) from the next step.
+            self.fresh = true;
+        }
         self.jacobian = Some((ys_end, j_end));
         let step = match end.and_then(|e| ringing.advance(t0, *t, &e)) {
             Some(step) => step,

@@ -156,10 +156,11 @@ pub trait OdeSystem {
     fn invariant_coordinates(&self) -> Vec<usize> {
         Vec::new()
     }
-    /// Per-component factors s_i on the error tolerance: a stepper that honours them
-    /// ([`Rodas5P`](super::Rodas5P)) measures y_i's error against s_i (atol + rtol |y_i|).
-    /// None (the default) for all 1. A modal velocity's factor is its mode's ω, so that its
-    /// tolerance carries the energy of its displacement's (½ δη̇² = ½ ω² δη²).
+    /// Per-component factors s_i on the absolute error tolerance: a stepper that honours
+    /// them ([`Rodas5P`](super::Rodas5P)) measures y_i's error against
+    /// s_i atol + rtol |y_i|; the vector has one factor per component of y. None (the
+    /// default) for all 1. A modal velocity's factor is its mode's ω, so that its tolerance
+    /// carries the energy of its displacement's (½ δη̇² = ½ ω² δη²).
     fn tolerance_scales(&self) -> Option<Vec<f64>> {
         None
     }
@@ -611,6 +612,30 @@ mod tests {
         assert!((0.7..=1.3).contains(&p), "slope {p}, errors {errs:?}");
         for (tol, e) in tols.iter().zip(&errs) {
             assert!(*e < 100.0 * tol, "error {e} at tolerance {tol}");
+        }
+    }
+
+    /// A correction added at a step's end by `add_linear` leaves the extension's start as it
+    /// was, moves its end by the correction and every interior point by the correction
+    /// times (t − t0)/h: the remaining terms of the extension vanish at both ends.
+    #[test]
+    fn a_linear_correction_moves_the_step_end_only() {
+        let r = [
+            vec![1.0, -2.0],
+            vec![0.5, 0.25],
+            vec![0.3, -0.7],
+            vec![-0.2, 0.9],
+            vec![0.05, 0.4],
+        ];
+        let plain = DenseStep::from_coefficients(2.0, 0.5, r.clone());
+        let mut corrected = DenseStep::from_coefficients(2.0, 0.5, r);
+        corrected.add_linear(1, 1e-3);
+        for k in 0..=8 {
+            let t = 2.0 + 0.5 * f64::from(k) / 8.0;
+            let (a, b) = (plain.component(1, t), corrected.component(1, t));
+            let expected = 1e-3 * f64::from(k) / 8.0;
+            assert!((b - a - expected).abs() <= 1e-15, "at {t}: {a} → {b}");
+            assert_eq!(plain.component(0, t), corrected.component(0, t));
         }
     }
 

@@ -323,12 +323,16 @@ impl Engine for Coupled {
         let (p, l, _) = self.momentum(y);
         p.0.iter().chain(&l.0).copied().collect()
     }
-    /// The base modes' velocities η̇_j at ω_j times the tolerance of their displacements
-    /// η_j (at least once: a mode below 1 rad/s keeps the common tolerance): an error in
-    /// either then carries the same energy, ½ δη̇² = ½ ω_j² δη². With one tolerance for both,
-    /// the slow run's quasi-static η̇ (the derivative of the base's deflection under the
-    /// chain's loads) set its steps, held to 1e-10 of √kg·m/s, at thousands of rad/s.
+    /// The base modes' velocities η̇_j at ω_j times the absolute tolerance of their
+    /// displacements η_j (at least once: a mode below 1 rad/s keeps the common tolerance):
+    /// an error in either then carries the same energy, ½ δη̇² = ½ ω_j² δη². With one
+    /// tolerance for both, the slow run's quasi-static η̇ (the derivative of the base's
+    /// deflection under the chain's loads) set its steps, held to 1e-10 of √kg·m/s, at
+    /// thousands of rad/s. None without base modes.
     fn slow_tolerance_scales(&self) -> Option<Vec<f64>> {
+        if self.modes() == 0 {
+            return None;
+        }
         let mut s = vec![1.0; Coupled::positions(self) + self.speeds()];
         let first = Coupled::positions(self) + self.hub_dof();
         for (si, w) in s[first..].iter_mut().zip(&self.base.omega[..self.modes()]) {

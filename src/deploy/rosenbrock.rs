@@ -220,8 +220,8 @@ pub(crate) fn forward_jacobian(sys: &dyn OdeSystem, t: f64, y: &[f64], f0: &[f64
 }
 
 /// Adaptive Rodas5P stepper. Error control as `Dopri5`'s, with the system's tolerance
-/// scales s_i ([`OdeSystem::tolerance_scales`]):
-/// ‖err_i / (s_i (atol + rtol·max(|y0_i|, |y1_i|)))‖_rms ≤ 1.
+/// scales s_i on the absolute part ([`OdeSystem::tolerance_scales`]):
+/// ‖err_i / (s_i atol + rtol·max(|y0_i|, |y1_i|))‖_rms ≤ 1.
 #[derive(Debug, Clone)]
 pub struct Rodas5P {
     /// Relative tolerance.
@@ -333,6 +333,9 @@ impl Rodas5P {
             }
         };
         let scales = sys.tolerance_scales();
+        if let Some(s) = &scales {
+            assert_eq!(s.len(), n, "one tolerance scale per component");
+        }
         let mut k = vec![vec![0.0; n]; STAGES];
         let mut yt = vec![0.0; n];
         let mut rhs = Mat::<f64>::zeros(n, 1);
@@ -377,8 +380,8 @@ impl Rodas5P {
                 .collect();
             let mut err = 0.0;
             for r in 0..n {
-                let sc = (self.atol + self.rtol * y[r].abs().max(y1[r].abs()))
-                    * scales.as_ref().map_or(1.0, |s| s[r]);
+                let sc = self.atol * scales.as_ref().map_or(1.0, |s| s[r])
+                    + self.rtol * y[r].abs().max(y1[r].abs());
                 err += (k[STAGES - 1][r] / sc).powi(2);
             }
             let err = if finite {
