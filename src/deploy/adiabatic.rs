@@ -195,8 +195,9 @@ fn eigen_both(a: &Mat<f64>) -> Option<(Vec<c64>, Mat<c64>, Mat<c64>)> {
     Some((lam, v, w))
 }
 
-/// The `count` eigenvalues of J with the largest |Im λ| (all those above `threshold` when
-/// `count` is None), with their right and left eigenvectors. The first `kinematic`
+/// The lightly damped eigenvalues of J ([`RINGING_DAMPING`]) above `threshold` in |Im λ|,
+/// at most `count` of them with the largest |Im λ| (all when `count` is None), with their
+/// right and left eigenvectors. The first `kinematic`
 /// coordinates (the hub's position and attitude, [`OdeSystem::kinematic`]) and those whose
 /// columns of J are zero are left out of the eigenproblem: they feed no other row, so for
 /// λ ≠ 0 their left components vanish and their right ones follow from their rows,
@@ -1203,7 +1204,7 @@ impl Adiabatic {
         }
         let ys = projection.0;
         self.extra_evaluations += 2 * differenced_columns(sys, y);
-        let Some(all) = fast_modes(
+        let Some((all, growth_s)) = fast_modes_and_growth(
             &central_jacobian(sys, &ys),
             sys.kinematic(),
             self.threshold,
@@ -1211,6 +1212,12 @@ impl Adiabatic {
         ) else {
             return;
         };
+        // The state was projected along `count` modes: the same number must carry its
+        // ringing at y_s, and nothing may grow there either (else the split is refused,
+        // and tried again later).
+        if all.lam.len() < count || growth_s > self.threshold {
+            return;
+        }
         self.refused = None;
         let modes = all.clone();
         let delta: Vec<f64> = y.iter().zip(&ys).map(|(a, b)| a - b).collect();
@@ -1514,12 +1521,16 @@ impl Adiabatic {
             .flatten();
         let end =
             tracked.or_else(|| fast_modes(&j_end, sys.kinematic(), self.threshold, Some(count)));
-        if end
-            .as_ref()
-            .is_some_and(|e| e.lam.iter().any(|l| l.re > self.threshold))
-        {
-            // A carried mode grows as fast as the base rings: split afresh (where the
-            // growth refuses it) from the next step.
+        if end.as_ref().is_some_and(|e| {
+            e.lam.iter().any(|l| {
+                l.re > self.threshold
+                    || l.im.abs() <= self.threshold
+                    || l.re.abs() > RINGING_DAMPING * l.im.abs()
+            })
+        }) {
+            // A mode at the step's end grows as fast as the base rings, or is no longer
+            // fast or lightly damped (tracking follows a carried mode wherever it goes):
+            // split afresh from the next step (refused while the growth lasts).
             self.fresh = true;
         }
         self.jacobian = Some((ys_end, j_end));

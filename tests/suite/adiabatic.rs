@@ -205,8 +205,8 @@ fn compliant_latches_without_the_cable_capture_in_turn_as_in_the_explicit_refere
 /// 0.1 s before the latch at 13.918 s. There J has a growing mode, and the adiabatic run
 /// integrates the state whole instead of splitting it (docs/theory.md §2.8). Against DOPRI5
 /// at 1e-8 (46 s; it agrees with DOPRI5 at 1e-10 to 1.2e-12 in the latch time): latch time
-/// to 3e-7 relative (measured 8.0e-8), the root rate before the latch to 5e-5 (1.9e-5), the
-/// kinetic energy before it to 5e-5 (2.5e-5 of 251.69 J). Before the refusal, a split in
+/// to 3e-7 relative (measured 7.1e-8), the root rate before the latch to 5e-5 (6.8e-6), the
+/// kinetic energy before it to 5e-5 (8.5e-6 of 251.69 J). Before the refusal, a split in
 /// the whip moved the rate from 7.5 to 0.34 rad/s. The run's non-convergence to DOPRI5 is
 /// the adiabatic approximation's floor in the whip: at 1e-10 the errors are 7.4e-8, 8.3e-6,
 /// 1.1e-5.
