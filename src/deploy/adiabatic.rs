@@ -1829,6 +1829,62 @@ mod tests {
     /// and 10 % over 10 s (~430 periods of the faster). At tolerance 1e-8: the state at the
     /// end to 1e-4 of the ringing's velocity amplitude (3.9e-5 measured), in under 400 steps
     /// (162), and the dense output continuous at every step's end.
+    /// [`Drift`] with a mechanism (q, p) beside it, q̇ = p, ṗ = a(s)² q, whose real
+    /// eigenvalues ±a(s), a = 30 exp(−((s − 0.01)/0.01)²), grow faster than the threshold
+    /// (10 rad/s) until s ≈ 0.0205 (t ≈ 1.02 s): q stays 0, but J has a growing mode there.
+    struct Whip;
+
+    impl OdeSystem for Whip {
+        fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+            Drift.rhs(t, &y[..5], &mut dy[..5]);
+            let a = 30.0 * (-((y[4] - 0.01) / 0.01).powi(2)).exp();
+            dy[5] = y[6];
+            dy[6] = a * a * y[5];
+        }
+    }
+
+    /// A state where J has a mode growing faster than the threshold is not split (the
+    /// whole state is integrated, its ringing resolved with the common tolerance); the split
+    /// is tried again every [`RESPLIT_STEPS`] steps and succeeds once the growth has passed,
+    /// and the run ends with the same accuracy against a tight DOPRI5 run as [`Drift`] alone.
+    #[test]
+    fn a_growing_mode_refuses_the_split_until_it_has_passed() {
+        let y0 = [1e-3, -2e-3, 0.05, 0.0, 0.0, 0.0, 0.0];
+        let t_end = 10.0;
+        let mut reference = y0.to_vec();
+        let mut dp = Dopri5::new(1e-12, 1e-14, f64::INFINITY);
+        let mut t = 0.0;
+        while t < t_end {
+            dp.step(&Whip, &mut t, &mut reference, t_end);
+        }
+        let mut ad = Adiabatic::new(1e-8, 1e-10, 10.0);
+        let (mut t, mut y) = (0.0, y0.to_vec());
+        let mut refused_until = 0.0;
+        let mut first = true;
+        while t < t_end {
+            let t0 = t;
+            ad.step(&Whip, &mut t, &mut y, t_end);
+            if first {
+                assert!(ad.refused.is_some(), "split at release, a = 11 rad/s");
+                first = false;
+            }
+            if ad.refused.is_some() {
+                refused_until = t0;
+            }
+        }
+        // Refused while a > 10 (t < 1.02 s), and split within 16 steps after.
+        assert!(
+            refused_until > 0.9 && refused_until < 1.3,
+            "refused until {refused_until} s"
+        );
+        assert!(ad.refused.is_none() && ad.ringing.is_some());
+        let err: f64 = (0..4)
+            .map(|i| (y[i] - reference[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-4 * 0.05, "error {err:e}");
+        assert_eq!(y[5], 0.0);
+    }
+
     #[test]
     fn the_ringing_follows_drifting_frequencies_as_a_tight_explicit_run_does() {
         let y0 = [1e-3, -2e-3, 0.05, 0.0, 0.0];
