@@ -1823,12 +1823,6 @@ mod tests {
         assert!(track(&j1, 1, &old, &swapped).is_none());
     }
 
-    /// A second formulation: DOPRI5 at 1e-12 resolving every period. The state starts off
-    /// the slow manifold (x at rest away from its quasi-static value, v₁ = 0.05), so both
-    /// oscillators ring (x₁'s velocity amplitude 0.05) while their frequencies drift by 20 %
-    /// and 10 % over 10 s (~430 periods of the faster). At tolerance 1e-8: the state at the
-    /// end to 1e-4 of the ringing's velocity amplitude (3.9e-5 measured), in under 400 steps
-    /// (162), and the dense output continuous at every step's end.
     /// y(t_end) from y0 by DOPRI5 at rtol 1e-12, atol 1e-14: the reference of the tests.
     fn tight_reference(sys: &dyn OdeSystem, y0: &[f64], t_end: f64) -> Vec<f64> {
         let mut y = y0.to_vec();
@@ -1891,6 +1885,12 @@ mod tests {
         assert_eq!(y[5], 0.0);
     }
 
+    /// A second formulation: DOPRI5 at 1e-12 resolving every period. The state starts off
+    /// the slow manifold (x at rest away from its quasi-static value, v₁ = 0.05), so both
+    /// oscillators ring (x₁'s velocity amplitude 0.05) while their frequencies drift by 20 %
+    /// and 10 % over 10 s (~430 periods of the faster). At tolerance 1e-8: the state at the
+    /// end to 1e-4 of the ringing's velocity amplitude (3.9e-5 measured), in under 400 steps
+    /// (162), and the dense output continuous at every step's end.
     #[test]
     fn the_ringing_follows_drifting_frequencies_as_a_tight_explicit_run_does() {
         let y0 = [1e-3, -2e-3, 0.05, 0.0, 0.0];
