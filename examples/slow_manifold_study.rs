@@ -21,9 +21,9 @@
 //! (base modes, tolerance, `project` | `release`, `fd` | `stiff` [, `--ringing 55`]).
 
 use faer::Mat;
-use flexcraft::deploy::adiabatic::{fast_threshold, slow_manifold, Adiabatic};
 use flexcraft::deploy::coupled::Coupled;
 use flexcraft::deploy::{Deployment, OdeSystem, Rodas5P};
+use flexcraft::ode::adiabatic::{fast_threshold, slow_manifold, Adiabatic};
 use flexcraft::Scenario;
 use std::time::Instant;
 

@@ -133,6 +133,7 @@ pub mod finite;
 pub mod limits;
 pub mod math;
 pub mod montecarlo;
+pub mod ode;
 #[cfg(feature = "cli")]
 pub mod output;
 pub mod response;

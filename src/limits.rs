@@ -194,6 +194,8 @@ pub const MAX_RITZ_DOF: usize = 4000;
 pub const MAX_RITZ_MODES: usize = 500;
 /// Relative integration tolerance.
 pub const TOLERANCE: Limit = closed(1e-14, 1e-3, "");
+/// `[deployment] accuracy`: the automatic integrator's results accuracy (relative).
+pub const ACCURACY: Limit = closed(1e-8, 0.1, "");
 /// Deployment end time and response duration.
 pub const DURATION: Limit = closed(1e-6, 1e6, "s");
 /// Modal damping ratio of the response, [0, 1): an underdamped structure.

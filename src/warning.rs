@@ -67,6 +67,9 @@ pub enum Warning {
     /// Rigid latches on an elastic base: the latch outcome with half of the kept base modes
     /// (the latch with the largest change of the base impulse).
     RigidLatchTruncation(crate::deploy::HalfModes),
+    /// The automatic integrator's accuracy estimate stayed above the accuracy asked for
+    /// after its last refinement.
+    AccuracyNotReached(crate::deploy::auto::Accuracy),
     /// Compliant latches still moving when the settling's cap, or the deployment's end time,
     /// ended the deployment.
     NotSettled {
@@ -191,6 +194,7 @@ impl fmt::Display for Warning {
                 h.modes,
                 h.kept
             ),
+            Self::AccuracyNotReached(a) => accuracy_not_reached(f, a),
             Self::AngleMismatch { rad } => write!(
                 f,
                 "the array locked away from the straight wing (largest hinge-angle mismatch \
@@ -215,6 +219,31 @@ impl fmt::Display for Warning {
 }
 
 /// [`Warning::NotSettled`]'s text.
+/// [`Warning::AccuracyNotReached`]'s text.
+fn accuracy_not_reached(
+    f: &mut fmt::Formatter<'_>,
+    a: &crate::deploy::auto::Accuracy,
+) -> fmt::Result {
+    if a.events_differ {
+        write!(
+            f,
+            "accuracy not reached: after {} runs, each refined twofold, the last two still \
+             differ in their latch events (count or order); the results are the finest run's, \
+             with no estimate (a deployment that is sensitive to its model there: compare runs \
+             with [deployment] base_modes or integrator = \"explicit\")",
+            a.runs
+        )
+    } else {
+        write!(
+            f,
+            "accuracy not reached: [deployment] accuracy = {:e} asked, {:.2e} estimated after \
+             {} runs, each refined twofold (the last two differ by that much: times {:.1e}, \
+             rates {:.1e}, latch moments {:.1e})",
+            a.asked, a.estimate, a.runs, a.times, a.rates, a.latch_moments
+        )
+    }
+}
+
 fn not_settled(t: f64, ratio: Option<f64>, tolerance: f64, by_end_time: bool) -> String {
     let left = ratio.map_or(String::new(), |r| {
         format!(

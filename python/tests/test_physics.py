@@ -103,6 +103,7 @@ panels = 1
 base = "rigid"
 end_time = 100.0
 output_rate = 10.0
+integrator = "explicit"
 tolerance = 1e-12
 
 [deployment.hinge]

@@ -14,6 +14,7 @@
 //! The frame's origin O is the hub's centre of mass; its axes are the structure axes.
 
 use super::inertia::{Invariants, MassPoint, RotaryPoint};
+use super::static_correction;
 use crate::basis::Quadrature;
 use crate::math::Vec3;
 use crate::ritz::assembly::HUB_DOF;
@@ -23,12 +24,29 @@ use crate::ritz::{RitzError, RitzModel};
 use crate::structure::{Attachment, ComponentId, HubMotion, Structure};
 
 /// How the base is modelled during deployment.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BaseKind {
     /// Elastic, by its hub-fixed Ritz modes (the default).
     Flexible {
         /// Number of kept modes (`None`: all of the base's Ritz model).
         modes: Option<usize>,
+    },
+    /// Elastic by its `modes` lowest hub-fixed modes, plus the static correction of the
+    /// others ([`static_correction`]): their residual flexibility under the loads the
+    /// deployment puts on the base (the root hinge's wrench and the hub's rigid-body
+    /// acceleration), as at most twelve M-orthonormal vectors. With every mode kept it is
+    /// [`BaseKind::Flexible`] with all modes.
+    Corrected {
+        /// Number of kept modes (clamped to the base's count).
+        modes: usize,
+    },
+    /// Elastic by its hub-fixed modes up to `cutoff` (rad/s), and at least `at_least` of
+    /// them, plus the static correction of the others, as [`BaseKind::Corrected`].
+    Reduced {
+        /// The highest kept mode's ω at most, rad/s (unless `at_least` asks for more).
+        cutoff: f64,
+        /// The fewest modes kept (clamped to the base's count).
+        at_least: usize,
     },
     /// Frozen rigid, with its full 3-D mass properties (the paper's staged route).
     Rigid,
@@ -62,8 +80,13 @@ pub struct BaseModel {
     pub hub_motion: HubMotion,
     /// Invariants of the whole base.
     pub invariants: Invariants,
-    /// ω of the kept modes, rad/s.
+    /// ω of the kept modes, rad/s (with [`BaseKind::Corrected`], the static correction's
+    /// vectors after the modes, their Rayleigh quotients ascending).
     pub omega: Vec<f64>,
+    /// How many of `omega` (and `shapes`) are the static correction's vectors, the last ones.
+    pub correction: usize,
+    /// ω of every hub-fixed mode of the base's Ritz model, rad/s, ascending (kept or not).
+    pub spectrum: Vec<f64>,
     /// The root hinge point (the deploying plate's attachment) from the hub's centre of mass.
     pub hinge: Vec3,
     /// Its displacement per mode, m.
@@ -92,7 +115,8 @@ impl BaseModel {
         let mut base_st = st.clone();
         let deploying = base_st.plates.remove(plate);
         let ritz = RitzModel::assemble(&base_st);
-        let (omega, shapes) = hub_fixed_modes(&ritz, kind)?;
+        let basis = hub_fixed_modes(&ritz, &deploying.attachment, kind)?;
+        let (omega, shapes) = (basis.omega, basis.shapes);
         let m = omega.len();
         let c_hub = st.hub.center_of_mass;
         let (hinge, hinge_shapes, hinge_rotations) =
@@ -129,6 +153,8 @@ impl BaseModel {
             hub_motion: st.hub.motion,
             invariants,
             omega,
+            correction: basis.correction,
+            spectrum: basis.spectrum,
             hinge: hinge - c_hub,
             hinge_shapes,
             hinge_rotations,
@@ -140,20 +166,37 @@ impl BaseModel {
     }
 }
 
+/// The base's reduction basis: kept modes, then the static correction's vectors.
+struct Basis {
+    omega: Vec<f64>,
+    shapes: Vec<Vec<f64>>,
+    correction: usize,
+    spectrum: Vec<f64>,
+}
+
 /// The lowest hub-fixed modes of the base, mass-normalised, as vectors over all of its
-/// coordinates.
+/// coordinates; with [`BaseKind::Corrected`], the static correction of the others after
+/// them.
 fn hub_fixed_modes(
     ritz: &RitzModel,
+    hinge: &Attachment,
     kind: BaseKind,
-) -> Result<(Vec<f64>, Vec<Vec<f64>>), RitzError> {
+) -> Result<Basis, RitzError> {
     let n = ritz.dof();
     let ne = n - HUB_DOF;
-    let keep = match kind {
-        BaseKind::Rigid => 0,
-        BaseKind::Flexible { modes } => modes.unwrap_or(ne).min(ne),
+    let (keep, corrected) = match kind {
+        BaseKind::Rigid => (0, false),
+        BaseKind::Flexible { modes } => (modes.unwrap_or(ne).min(ne), false),
+        BaseKind::Corrected { modes } => (modes.min(ne), true),
+        BaseKind::Reduced { .. } => (0, true),
     };
-    if keep == 0 {
-        return Ok((Vec::new(), Vec::new()));
+    if (keep == 0 && !corrected) || ne == 0 {
+        return Ok(Basis {
+            omega: Vec::new(),
+            shapes: Vec::new(),
+            correction: 0,
+            spectrum: Vec::new(),
+        });
     }
     let mee = ritz.mass.submatrix(HUB_DOF, HUB_DOF, ne, ne).to_owned();
     let kee = ritz
@@ -161,17 +204,39 @@ fn hub_fixed_modes(
         .submatrix(HUB_DOF, HUB_DOF, ne, ne)
         .to_owned();
     let (lam, phi) = generalized_symmetric(&kee, &mee)?;
-    let omega = lam[..keep].iter().map(|l| l.max(0.0).sqrt()).collect();
-    let shapes = (0..keep)
-        .map(|j| {
-            let mut v = vec![0.0; n];
-            for i in 0..ne {
-                v[HUB_DOF + i] = phi[(i, j)];
-            }
-            v
-        })
+    let spectrum: Vec<f64> = lam.iter().map(|l| l.max(0.0).sqrt()).collect();
+    let keep = match kind {
+        BaseKind::Reduced { cutoff, at_least } => spectrum
+            .iter()
+            .take_while(|w| **w <= cutoff)
+            .count()
+            .max(at_least)
+            .min(ne),
+        _ => keep,
+    };
+    let mut omega: Vec<f64> = spectrum[..keep].to_vec();
+    let widen = |v: &[f64]| {
+        let mut w = vec![0.0; n];
+        w[HUB_DOF..].copy_from_slice(v);
+        w
+    };
+    let mut shapes: Vec<Vec<f64>> = (0..keep)
+        .map(|j| widen(&(0..ne).map(|i| phi[(i, j)]).collect::<Vec<_>>()))
         .collect();
-    Ok((omega, shapes))
+    let mut correction = 0;
+    if corrected && keep < ne {
+        let loads = static_correction::deployment_loads(ritz, hinge);
+        let (w, v) = static_correction::vectors(&lam, &phi, keep, &loads);
+        correction = w.len();
+        omega.extend(w);
+        shapes.extend(v.iter().map(|x| widen(x)));
+    }
+    Ok(Basis {
+        omega,
+        shapes,
+        correction,
+        spectrum,
+    })
 }
 
 /// The point where an attachment sits, with its displacement and rotation per mode.

@@ -38,8 +38,8 @@ use super::attitude::{self, Quaternion};
 use super::base::BaseModel;
 use super::chain::{Chain, P2};
 use super::inertia::{combine, AtShape};
-use super::integrator::{Change, Tie};
 use crate::math::{dot4, Mat3, Vec3};
+use crate::ode::integrator::{Change, Tie};
 use crate::structure::HubMotion;
 use faer::{Mat, Side};
 use std::cell::RefCell;
@@ -262,7 +262,7 @@ impl Coupled {
         }
     }
 
-    /// With an ideal cable and some hinge free ([`OdeSystem`](super::integrator::OdeSystem)
+    /// With an ideal cable and some hinge free ([`OdeSystem`](crate::ode::integrator::OdeSystem)
     /// ties): the opening angles and their rates, each along the cable's speed vector
     /// r = (1, 2, 2, …) (α − α(0) = r (α₁ − α₁(0)), α̇ = r α̇₁); none otherwise.
     pub fn cable_ties(&self, free: &[bool]) -> Vec<Tie> {
@@ -1897,6 +1897,7 @@ impl Coupled {
             tolerance: tol,
             integrator: super::Integrator::Explicit,
             record_samples: true,
+            schedule: super::run::Schedule::default(),
             settle: self
                 .latch
                 .as_ref()

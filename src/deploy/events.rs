@@ -1,7 +1,7 @@
 //! The latch-event finder: the earliest crossing of a latch angle within one accepted step,
 //! located on the step's dense output.
 
-use super::integrator::{locate, DenseStep};
+use crate::ode::integrator::{locate, DenseStep};
 
 /// Interior points at which each step is sampled so that a crossing and return within one
 /// step is not missed.
@@ -58,7 +58,7 @@ pub fn earliest_latch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::integrator::{Dopri5, OdeSystem};
+    use crate::ode::integrator::{Dopri5, OdeSystem};
 
     /// From y = (0, 1, 0): components sin t, cos t and 2 sin t.
     struct Waves;

@@ -22,10 +22,10 @@ use super::attitude;
 use super::chain::{Hinge, P2};
 use super::coupled::{Coupled, Eval, Solution, Synchronisation};
 use super::inertia::combine;
-use super::integrator::{Change, Tie};
 use super::run::{Engine, Impulses};
 use super::{BodySample, Sample};
 use crate::math::Vec3;
+use crate::ode::integrator::{Change, Tie};
 
 /// ẑ, the hinge axis in hinge components.
 const Z: Vec3 = Vec3::new(0.0, 0.0, 1.0);
@@ -282,12 +282,49 @@ impl Engine for Coupled {
             super::latch_period(&self.chain, &l.stiffness, self.sync)
         })
     }
+    fn array_fastest(&self, moving: &[bool], latched: &[bool]) -> f64 {
+        let latch: Vec<f64> = match &self.latch {
+            Some(l) => l
+                .stiffness
+                .iter()
+                .zip(latched.iter().chain(std::iter::repeat(&false)))
+                .map(|(k, on)| if *on { *k } else { 0.0 })
+                .collect(),
+            None => Vec::new(),
+        };
+        super::timescales::fastest(&self.chain, &latch, self.sync, moving)
+    }
+    fn base_resolved(&self) -> f64 {
+        let kept = self.modes() - self.base.correction;
+        self.base.omega[..kept].iter().copied().fold(0.0, f64::max)
+    }
+    fn latch_window(&self, captured: &[bool]) -> f64 {
+        let Some(l) = &self.latch else {
+            return 0.0;
+        };
+        let q: Vec<f64> = self.chain.hinges.iter().map(|h| h.latch_angle).collect();
+        let slowest = super::timescales::array_frequencies(
+            &self.chain,
+            &q,
+            &l.stiffness,
+            self.sync,
+            captured,
+        )
+        .first()
+        .copied()
+        .unwrap_or(0.0);
+        if slowest > 0.0 {
+            2.0 * std::f64::consts::PI / slowest
+        } else {
+            0.0
+        }
+    }
     fn fast_threshold(&self) -> f64 {
         let lowest = self.base.omega[..self.modes()]
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min);
-        super::adiabatic::fast_threshold(lowest)
+        crate::ode::adiabatic::fast_threshold(lowest)
     }
     fn rhs(&self, y: &[f64], free: &[bool], captured: &[bool], dy: &mut [f64]) {
         self.rhs_captured(y, free, captured, dy);
@@ -495,8 +532,8 @@ mod tests {
     /// the cable's manifold.
     #[test]
     fn the_cable_ties_jacobian_equals_the_full_one_on_the_cable_tangent_space() {
-        use crate::deploy::integrator::{OdeSystem, Tie};
-        use crate::deploy::rosenbrock::forward_jacobian;
+        use crate::ode::integrator::{OdeSystem, Tie};
+        use crate::ode::rosenbrock::forward_jacobian;
         struct Sys<'a>(&'a Coupled, bool);
         impl OdeSystem for Sys<'_> {
             fn rhs(&self, _t: f64, y: &[f64], dy: &mut [f64]) {

@@ -4,31 +4,31 @@
 //! structure ([`planar`]), and the run with latch events,
 //! samples, its status and warnings ([`simulate`]).
 
-pub mod adiabatic;
 pub(crate) mod articulated;
 pub mod attitude;
+pub mod auto;
 pub mod base;
 pub mod chain;
 pub mod coupled;
 pub(crate) mod events;
 pub mod inertia;
-pub(crate) mod integrator;
 pub mod loads;
 pub mod peaks;
 pub mod planar;
-pub(crate) mod rosenbrock;
-mod run;
+pub(crate) mod run;
+pub mod static_correction;
 pub mod sweep;
 pub mod swing;
+pub mod timescales;
 
+pub use crate::ode::{Change, DenseStep, OdeSystem, Rodas5P, Tie};
 use crate::ritz::RitzError;
 use crate::structure::Structure;
 use crate::warning::Warning;
 use base::{BaseKind, BaseModel};
 use chain::{Chain, PlanarHub, P2};
 use coupled::{Coupled, Synchronisation};
-pub use integrator::{Change, DenseStep, OdeSystem, Tie};
-pub use rosenbrock::Rodas5P;
+pub use run::Schedule;
 pub use swing::SwingBack;
 
 /// Why a coupled deployment could not be built.
@@ -65,8 +65,10 @@ pub struct Deployment {
     pub end_time: f64,
     /// Sample rate, Hz: samples at t = k / output_rate.
     pub output_rate: f64,
-    /// Relative integration tolerance.
+    /// Relative integration tolerance (the named integrators').
     pub tolerance: f64,
+    /// The results' accuracy asked of the automatic integrator (relative; [`auto`]).
+    pub accuracy: f64,
     /// The base during deployment: flexible (its hub-fixed modes) or frozen rigid.
     pub base: BaseKind,
     /// How the hinges are tied.
@@ -84,16 +86,19 @@ pub struct Deployment {
 /// The time integrator of a deployment run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// DOPRI5, explicit Runge–Kutta 5(4) (the default): cheap steps that conserve energy to
-    /// the tolerance, bound by the highest kept base mode (h < 3.3/ω_max) when that mode is
-    /// stiff.
+    /// The default: the method chosen for the spacecraft (docs/theory.md §2.9) — Rodas5P at
+    /// steps set by what each phase of the deployment must resolve, the base's modes above
+    /// that followed quasi-statically.
     #[default]
+    Auto,
+    /// DOPRI5, explicit Runge–Kutta 5(4): cheap steps that conserve energy to the tolerance,
+    /// bound by the highest kept base mode (h < 3.3/ω_max) when that mode is stiff.
     Explicit,
     /// Rodas5P, L-stable Rosenbrock of order 5: steps set by the resolved motion whatever the
     /// highest mode (unresolved modes are damped numerically); a Jacobian per step.
     Implicit,
     /// The slow motion by Rodas5P on its slow manifold, the base's ringing carried along it
-    /// mode by mode ([`adiabatic`]): steps set by the deployment, not by the base modes,
+    /// mode by mode ([`crate::ode::adiabatic`]): steps set by the deployment, not by the base modes,
     /// which are kept (not damped).
     Adiabatic,
 }
@@ -124,56 +129,7 @@ pub const SETTLE_TOLERANCE: f64 = 1e-2;
 /// The settling's cap, in [`latch_period`]s after the last capture.
 pub const SETTLE_PERIODS: f64 = 100.0;
 
-/// The latch mode's period, s: the slowest free vibration of the captured array about its
-/// latch angles with the base held, M(α_L) ẍ + K x = 0, M the chain's mass matrix (hinge
-/// coordinates), K = diag(k_j + k_L,j) (hinge springs and latches) plus k_c CᵀC for an
-/// elastic cable; with an ideal cable on its one speed, α̇ = (1, 2, 2, …) ṡ. On seed_compliant
-/// (ideal cable) 0.406 s (15.49 rad/s), against 0.403 s (15.6 rad/s) for the coupled mode on
-/// the free, flexible spacecraft. Zero when the problem is degenerate (no panels).
-pub fn latch_period(chain: &Chain, stiffness: &[f64], sync: Synchronisation) -> f64 {
-    let n = chain.len();
-    let held = Chain {
-        hub: PlanarHub::Fixed,
-        ..chain.clone()
-    };
-    let q: Vec<f64> = held.hinges.iter().map(|h| h.latch_angle).collect();
-    let m = held.mass_matrix(&q);
-    let mut k = faer::Mat::<f64>::from_fn(n, n, |i, j| {
-        if i == j {
-            held.hinges[i].stiffness + stiffness[i]
-        } else {
-            0.0
-        }
-    });
-    if let Synchronisation::ElasticCable(kc) = sync {
-        for row in Coupled::cable_law(n) {
-            for i in 0..n {
-                for j in 0..n {
-                    k[(i, j)] += kc * row[i] * row[j];
-                }
-            }
-        }
-    }
-    let lowest = if sync == Synchronisation::IdealCable {
-        let c: Vec<f64> = (0..n).map(|i| if i == 0 { 1.0 } else { 2.0 }).collect();
-        let quad = |a: &faer::Mat<f64>| -> f64 {
-            (0..n)
-                .map(|i| (0..n).map(|j| c[i] * a[(i, j)] * c[j]).sum::<f64>())
-                .sum()
-        };
-        quad(&k) / quad(&m)
-    } else {
-        crate::ritz::eigen::generalized_symmetric(&k, &m)
-            .ok()
-            .and_then(|(lambda, _)| lambda.first().copied())
-            .unwrap_or(f64::NAN)
-    };
-    if lowest.is_finite() && lowest > 0.0 {
-        2.0 * std::f64::consts::PI / lowest.sqrt()
-    } else {
-        0.0
-    }
-}
+pub use timescales::latch_period;
 
 /// How long a deployment with compliant latches goes on after the last capture, before the
 /// hand-over.
@@ -248,6 +204,8 @@ pub struct RunSettings {
     pub integrator: Integrator,
     /// With compliant latches: how long the run continues after the last capture.
     pub settle: Option<Settle>,
+    /// The automatic integrator's step rule.
+    pub schedule: run::Schedule,
     /// Record the samples at k / output_rate (false: only the first, those at the latch
     /// events and the load peaks tracked at every step — what a Monte Carlo run reads;
     /// building a sample evaluates the whole model and was 58 % of such a run).
@@ -432,6 +390,11 @@ pub struct DeploymentResult {
     pub evaluations: usize,
     /// With compliant latches all captured: how the settling ended.
     pub settled: Option<Settled>,
+    /// With the automatic integrator: its model and its accuracy estimate.
+    pub accuracy: Option<auto::Accuracy>,
+    /// The same peaks from the first impact or capture on: the latch-ups' loads, apart from
+    /// the release's transient.
+    pub latch_up_peaks: Vec<peaks::Peak>,
     /// Peaks of the engine's tracked load magnitudes ([`peaks`]), observed at every step
     /// (coupled model: every hinge's latch moment, then every base beam's root force and
     /// root moment, then every hinge's reaction force, every hinge's transmitted moment, and
@@ -493,13 +456,23 @@ pub fn simulate_coupled_with(
     d: &Deployment,
     record_samples: bool,
 ) -> Result<(Coupled, DeploymentResult), DeployError> {
-    let c = d.coupled(st)?;
-    let settings = RunSettings {
-        record_samples,
-        ..d.settings()
+    let (c, mut r) = if d.integrator == Integrator::Auto {
+        let (c, mut r, acc) = auto::simulate(st, d, record_samples)?;
+        if !acc.reached() {
+            r.warnings.push(Warning::AccuracyNotReached(acc.clone()));
+        }
+        r.accuracy = Some(acc);
+        (c, r)
+    } else {
+        let c = d.coupled(st)?;
+        let settings = RunSettings {
+            record_samples,
+            ..d.settings()
+        };
+        let mut r = run::run(&c, &settings, MAX_STEPS);
+        truncation_check(st, d, &c, &mut r)?;
+        (c, r)
     };
-    let mut r = run::run(&c, &settings, MAX_STEPS);
-    truncation_check(st, d, &c, &mut r)?;
     if let BaseKind::Flexible {
         modes: Some(requested),
     } = d.base
@@ -614,6 +587,7 @@ impl Deployment {
                 )),
             },
             record_samples: true,
+            schedule: run::Schedule::default(),
         }
     }
 

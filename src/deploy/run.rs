@@ -4,16 +4,17 @@
 //! planar chain ([`PlanarEngine`], the rigid reference) or the coupled model
 //! ([`super::coupled::Coupled`]).
 
-use super::adiabatic::Adiabatic;
 use super::chain::{Chain, Hinge, PlanarHub, P2};
 use super::events::{self, Crossing};
-use super::integrator::{each_change, Change, DenseStep, Dopri5, OdeSystem, Tie};
 use super::peaks::PeakTracker;
-use super::rosenbrock::Rodas5P;
 use super::swing::SwingTracker;
 use super::Integrator;
 use super::{Capture, DeploymentResult, LatchEvent, Latching, RunSettings, RunStatus, Sample};
 use super::{Settle, Settled, SETTLE_TOLERANCE};
+use crate::ode::adiabatic::Adiabatic;
+use crate::ode::integrator::{each_change, Change, DenseStep, Dopri5, OdeSystem, Tie};
+use crate::ode::restore::Restorer;
+use crate::ode::rosenbrock::Rodas5P;
 use crate::warning::Warning;
 
 /// The impulses of one impact.
@@ -54,8 +55,25 @@ pub(crate) trait Engine {
     fn latch_period(&self) -> f64 {
         0.0
     }
+    /// The fastest motion of the array the automatic integrator's steps resolve
+    /// ([`super::timescales::fastest`]), rad/s: the hinges flagged in `moving` on their
+    /// springs, with the latch springs of those flagged in `latched` acting; 0 by default.
+    fn array_fastest(&self, _moving: &[bool], _latched: &[bool]) -> f64 {
+        0.0
+    }
+    /// The highest frequency of the base's kept modes (not its static correction), rad/s: the
+    /// scheduled steps resolve it, so that the base's vibration below the cutoff is carried,
+    /// not damped; 0 by default.
+    fn base_resolved(&self) -> f64 {
+        0.0
+    }
+    /// The captured hinges' slowest latch period, s ([`super::timescales::latch_period`] on
+    /// the hinges flagged in `captured`, the others locked); 0 without compliant latches.
+    fn latch_window(&self, _captured: &[bool]) -> f64 {
+        0.0
+    }
     /// For the adiabatic integrator: |Im λ| of ∂f/∂y above which an eigenvalue is the
-    /// base's vibration, rad/s ([`super::adiabatic::fast_threshold`]); infinite (no ringing)
+    /// base's vibration, rad/s ([`crate::ode::adiabatic::fast_threshold`]); infinite (no ringing)
     /// by default.
     fn fast_threshold(&self) -> f64 {
         f64::INFINITY
@@ -156,6 +174,9 @@ impl Engine for PlanarEngine<'_> {
         let (q0, qd0) = self.0.initial_state();
         q0.iter().chain(&qd0).copied().collect()
     }
+    fn array_fastest(&self, moving: &[bool], _latched: &[bool]) -> f64 {
+        super::timescales::fastest(self.0, &[], super::coupled::Synchronisation::None, moving)
+    }
     fn rhs(&self, y: &[f64], free: &[bool], _captured: &[bool], dy: &mut [f64]) {
         let chain = self.0;
         let (n, h) = (chain.dof(), chain.hub_dof());
@@ -218,17 +239,97 @@ impl Engine for PlanarEngine<'_> {
     }
 }
 
+/// The automatic integrator's step rule (docs/theory.md §2.9): Rodas5P at steps set by what
+/// the deployment's current phase must resolve, h = min(κ / ω, δ / |α̇|, √(2δ / |α̈|)) —
+/// ω the array's fastest motion in the phase ([`super::timescales::fastest`]: its hinge springs
+/// in the free swing, with the latch springs during a latch-up), α̇ and α̈ the open hinges'
+/// rates and accelerations (δ the largest turn of a hinge in one step). The base's modes
+/// above 1/h are not resolved: the L-stable steps let them follow their quasi-static
+/// solution ([`Rodas5P::step_scheduled`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Schedule {
+    /// κ: the step's fraction of 1/ω.
+    pub kappa: f64,
+    /// δ, rad: the largest turn of a hinge in one step.
+    pub delta: f64,
+}
+
+impl Default for Schedule {
+    fn default() -> Self {
+        Self {
+            kappa: 1.0,
+            delta: 0.02,
+        }
+    }
+}
+
+/// Rodas5P at scheduled steps, the conserved quantities restored after each.
+struct Scheduled {
+    rodas: Rodas5P,
+    restorer: Restorer,
+    rule: Schedule,
+    /// The phase's ω (rad/s).
+    omega: f64,
+    /// The longest step at all, s.
+    longest: f64,
+}
+
+impl Scheduled {
+    fn step(
+        &mut self,
+        sys: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_end: f64,
+        open_rates: std::ops::Range<usize>,
+        open: &[bool],
+    ) -> DenseStep {
+        self.restorer.start(sys, y);
+        let f = self.rodas.derivative(sys, *t, y);
+        let mut h = self.longest;
+        if self.omega > 0.0 {
+            h = h.min(self.rule.kappa / self.omega);
+        }
+        for (j, k) in open_rates.enumerate() {
+            if open.get(j).copied().unwrap_or(false) {
+                h = h
+                    .min(self.rule.delta / y[k].abs())
+                    .min((2.0 * self.rule.delta / f[k].abs()).sqrt());
+            }
+        }
+        let mut dense = self.rodas.step_scheduled(sys, t, y, t_end, h);
+        if y.iter().all(|v| v.is_finite()) {
+            let correction = self.restorer.restore(sys, y, false);
+            if correction.iter().any(|(_, d)| *d != 0.0) {
+                for &(k, d) in &correction {
+                    dense.add_linear(k, d);
+                }
+                self.rodas.refresh_derivative(sys, *t, y);
+            }
+        }
+        dense
+    }
+}
+
 /// The stepper a run uses.
 enum Stepper {
     Explicit(Dopri5),
     Implicit(Rodas5P),
     Adiabatic(Box<Adiabatic>),
+    Scheduled(Box<Scheduled>),
 }
 
 impl Stepper {
     fn new(s: &RunSettings, fast_threshold: f64) -> Self {
         let (rtol, atol) = (s.tolerance, s.tolerance * 1e-2);
         match s.integrator {
+            Integrator::Auto => Self::Scheduled(Box::new(Scheduled {
+                rodas: Rodas5P::new(rtol, atol, f64::INFINITY),
+                restorer: Restorer::default(),
+                rule: s.schedule,
+                omega: 0.0,
+                longest: LONGEST_STEP * s.end_time,
+            })),
             Integrator::Explicit => Self::Explicit(Dopri5::new(rtol, atol, f64::INFINITY)),
             Integrator::Implicit => Self::Implicit(Rodas5P::new(rtol, atol, f64::INFINITY)),
             Integrator::Adiabatic => {
@@ -241,13 +342,19 @@ impl Stepper {
             Self::Explicit(s) => s.step(sys, t, y, t_end),
             Self::Implicit(s) => s.step(sys, t, y, t_end),
             Self::Adiabatic(s) => s.step(sys, t, y, t_end),
+            // The run calls Scheduled::step itself (it needs the open hinges).
+            Self::Scheduled(s) => s.step(sys, t, y, t_end, 0..0, &[]),
         }
     }
     /// A state taken from the dense output (an event's) with its conserved quantities
     /// restored, for the stepper that restores them after every step.
     fn conserve(&mut self, sys: &dyn OdeSystem, y: &mut [f64]) {
-        if let Self::Adiabatic(s) = self {
-            s.conserve(sys, y);
+        match self {
+            Self::Adiabatic(s) => s.conserve(sys, y),
+            Self::Scheduled(s) => {
+                s.restorer.restore(sys, y, true);
+            }
+            _ => {}
         }
     }
     fn restart(&mut self) {
@@ -255,6 +362,7 @@ impl Stepper {
             Self::Explicit(s) => s.restart(),
             Self::Implicit(s) => s.restart(),
             Self::Adiabatic(s) => s.restart(),
+            Self::Scheduled(s) => s.rodas.restart(),
         }
     }
     fn evaluations(&self) -> usize {
@@ -262,6 +370,7 @@ impl Stepper {
             Self::Explicit(s) => s.evaluations,
             Self::Implicit(s) => s.evaluations,
             Self::Adiabatic(s) => s.evaluations(),
+            Self::Scheduled(s) => s.rodas.evaluations + s.restorer.evaluations,
         }
     }
 }
@@ -317,6 +426,10 @@ impl<E: Engine> OdeSystem for System<'_, E> {
     }
 }
 
+/// A latch-up under way (the scheduled stepper's): since when (s), its window (s), and the
+/// captured hinges' largest |α̇| in the window, decreasing.
+type LatchUp = (f64, f64, std::collections::VecDeque<(f64, f64)>);
+
 /// The state of a run between steps.
 struct Run<'a, E: Engine> {
     s: &'a RunSettings,
@@ -343,6 +456,12 @@ struct Run<'a, E: Engine> {
     /// The engine's latch period ([`Engine::latch_period`]: a small eigenproblem, so
     /// computed once), s.
     latch_period: f64,
+    /// The load peaks from the first impact or capture on (the latch-ups'), as `peaks`.
+    latch_up_peaks: PeakTracker,
+    /// With the scheduled stepper, the latch-up under way: since when (s), its window (the
+    /// captured hinges' slowest latch period, s), and the captured hinges' largest |α̇| in it,
+    /// as [`Self::recent`].
+    latch_up: Option<LatchUp>,
     /// The current step's observations resolve the motion, so that the peak tracker may
     /// interpolate between them; false where the adiabatic stepper's ringing turns by more
     /// than [`LOAD_PHASE`] between them (a parabola through such points is no peak).
@@ -381,7 +500,83 @@ impl<'a, E: Engine> Run<'a, E> {
             settled: None,
             last_event: f64::NEG_INFINITY,
             latch_period: engine.latch_period(),
+            latch_up_peaks: PeakTracker::default(),
+            latch_up: None,
             resolved: true,
+        }
+        .with_phase()
+    }
+
+    /// Hinges that still open (free, not captured).
+    fn open_mask(&self) -> Vec<bool> {
+        self.sys.open()
+    }
+
+    /// The scheduled stepper's ω for the current phase: during a latch-up, the open and the
+    /// captured hinges with the captured ones' latch springs; otherwise the open hinges alone
+    /// (captured hinges then sit quasi-statically on their latches, locked ones do not move).
+    fn with_phase(mut self) -> Self {
+        self.set_phase();
+        self
+    }
+
+    fn set_phase(&mut self) {
+        let open = self.open_mask();
+        let omega = match &self.latch_up {
+            Some(_) => {
+                let moving: Vec<bool> = open
+                    .iter()
+                    .zip(&self.sys.captured)
+                    .map(|(o, c)| *o || *c)
+                    .collect();
+                self.sys.engine.array_fastest(&moving, &self.sys.captured)
+            }
+            None => self.sys.engine.array_fastest(&open, &[]),
+        };
+        // The base's kept modes are resolved from the first impact or capture on: each
+        // excites them, and in an undamped base their vibration lasts and reaches the later
+        // events (a hinge creeping into its latch meets the base still ringing from the
+        // earlier latch-ups). Before it only the release has (a step of the hinge springs'
+        // moments, small against a latch-up's), and steps set by the array let that
+        // vibration settle quasi-statically.
+        let base = if self.last_event.is_finite() {
+            self.sys.engine.base_resolved()
+        } else {
+            0.0
+        };
+        if let Stepper::Scheduled(s) = &mut self.solver {
+            s.omega = omega.max(base);
+        }
+    }
+
+    /// With the scheduled stepper after a capture: the latch-up lasts until the captured
+    /// hinges' rates have stayed below [`SETTLE_TOLERANCE`] of the largest rate at a capture
+    /// for one window (the captured hinges' slowest latch period, [`Engine::latch_window`]),
+    /// and at most [`super::SETTLE_PERIODS`] windows; then the steps no longer resolve the
+    /// latches (they hold their hinges quasi-statically).
+    fn start_latch_up(&mut self, t: f64) {
+        if !matches!(self.solver, Stepper::Scheduled(_)) {
+            return;
+        }
+        let window = self.sys.engine.latch_window(&self.sys.captured);
+        self.latch_up = Some((t, window, std::collections::VecDeque::new()));
+        self.set_phase();
+    }
+
+    /// After a step: whether the latch-up under way has ended.
+    fn watch_latch_up(&mut self, step: &DenseStep) {
+        let Some((since, window, mut recent)) = self.latch_up.take() else {
+            return;
+        };
+        let ratio = self.rates_in(step, window, &mut recent);
+        let elapsed = self.t - since;
+        if (elapsed >= window && ratio <= SETTLE_TOLERANCE)
+            || elapsed >= super::SETTLE_PERIODS * window
+            || window == 0.0
+        {
+            self.set_phase();
+        } else {
+            self.latch_up = Some((since, window, recent));
         }
     }
 
@@ -443,6 +638,19 @@ impl<'a, E: Engine> Run<'a, E> {
     /// points of every step since the last capture (16 per window at least), over the
     /// largest hinge rate at a capture.
     fn rates_left(&mut self, step: &DenseStep, window: f64) -> f64 {
+        let mut recent = std::mem::take(&mut self.recent);
+        let ratio = self.rates_in(step, window, &mut recent);
+        self.recent = recent;
+        ratio
+    }
+
+    /// [`Self::rates_left`] over the captured hinges, into the deque `recent`.
+    fn rates_in(
+        &self,
+        step: &DenseStep,
+        window: f64,
+        recent: &mut std::collections::VecDeque<(f64, f64)>,
+    ) -> f64 {
         let engine = self.sys.engine;
         let ro = engine.positions() + engine.rate_offset();
         let mut rates = vec![0.0; self.latch_angles.len()];
@@ -459,21 +667,21 @@ impl<'a, E: Engine> Run<'a, E> {
                 step.t0 + span * k as f64 / n as f64
             };
             step.components(ro, t, &mut rates);
-            let loudest = rates.iter().fold(0.0, |m: f64, r| m.max(r.abs()));
+            let loudest = rates
+                .iter()
+                .zip(&self.sys.captured)
+                .filter(|(_, c)| **c)
+                .fold(0.0, |m: f64, (r, _)| m.max(r.abs()));
             // A decreasing deque: its front is the window's largest.
-            while self.recent.back().is_some_and(|&(_, v)| v <= loudest) {
-                self.recent.pop_back();
+            while recent.back().is_some_and(|&(_, v)| v <= loudest) {
+                recent.pop_back();
             }
-            self.recent.push_back((t, loudest));
+            recent.push_back((t, loudest));
         }
-        while self
-            .recent
-            .front()
-            .is_some_and(|&(t, _)| t < self.t - window)
-        {
-            self.recent.pop_front();
+        while recent.front().is_some_and(|&(t, _)| t < self.t - window) {
+            recent.pop_front();
         }
-        let largest = self.recent.front().map_or(0.0, |r| r.1);
+        let largest = recent.front().map_or(0.0, |r| r.1);
         let scale = self
             .captures
             .iter()
@@ -509,9 +717,21 @@ impl<'a, E: Engine> Run<'a, E> {
         let off = self.sys.engine.alpha_offset();
         let y_start = self.y.clone();
         let t_stop = self.t_stop();
-        let step = self
-            .solver
-            .step(&self.sys, &mut self.t, &mut self.y, t_stop);
+        let step = match &mut self.solver {
+            Stepper::Scheduled(s) => {
+                let ro = self.sys.engine.positions() + self.sys.engine.rate_offset();
+                let open = self.sys.open();
+                s.step(
+                    &self.sys,
+                    &mut self.t,
+                    &mut self.y,
+                    t_stop,
+                    ro..ro + open.len(),
+                    &open,
+                )
+            }
+            solver => solver.step(&self.sys, &mut self.t, &mut self.y, t_stop),
+        };
         if !self.y.iter().all(|v| v.is_finite()) {
             self.y.copy_from_slice(&y_start);
             self.t = step.t0;
@@ -535,6 +755,7 @@ impl<'a, E: Engine> Run<'a, E> {
                 let r = self.alpha_range();
                 self.swing.observe(self.t, &self.y[r]);
                 self.observe_loads();
+                self.watch_latch_up(&step);
                 if !self.moving() {
                     self.watch_settling(&step);
                 }
@@ -557,6 +778,7 @@ impl<'a, E: Engine> Run<'a, E> {
         self.last_event = e.t;
         self.observe_loads();
         self.peaks.break_history();
+        self.latch_up_peaks.break_history();
         let open = self.sys.open();
         // A compliant latch captures its hinge when the hinge reaches it; "simultaneous"
         // latching does not apply (it would pull bent hinges onto their latch angles), and
@@ -586,6 +808,7 @@ impl<'a, E: Engine> Run<'a, E> {
                 .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
         }
         self.solver.restart();
+        self.start_latch_up(e.t);
     }
 
     /// Observes the tracked load magnitudes at the current state.
@@ -602,8 +825,13 @@ impl<'a, E: Engine> Run<'a, E> {
     fn observe(&mut self, t: f64, m: &[f64]) {
         if !self.resolved {
             self.peaks.break_history();
+            self.latch_up_peaks.break_history();
+            self.latch_up_peaks.break_history();
         }
         self.peaks.observe(t, m);
+        if self.last_event.is_finite() {
+            self.latch_up_peaks.observe(t, m);
+        }
     }
 
     /// How long after an impact or a capture the tracked loads are also observed inside the
@@ -634,6 +862,7 @@ impl<'a, E: Engine> Run<'a, E> {
         if !self.resolved {
             // No parabola spans the unresolved step before this one.
             self.peaks.break_history();
+            self.latch_up_peaks.break_history();
         }
         // Resolved: the observations (inner points and the end) no farther apart than
         // LOAD_PHASE / ω (the spacing's rounding aside).
@@ -703,6 +932,7 @@ impl<'a, E: Engine> Run<'a, E> {
         }
         self.observe_loads();
         self.peaks.break_history();
+        self.latch_up_peaks.break_history();
         let before = engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured);
         let energy_before = engine.kinetic_energy(&self.y);
         let (u_new, impulses) = engine.impact(&self.y, &free_after);
@@ -739,6 +969,7 @@ impl<'a, E: Engine> Run<'a, E> {
         self.samples
             .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
         self.solver.restart();
+        self.set_phase();
     }
 
     /// Simultaneous latching without a cable locks the array where it stands: the warning
@@ -831,10 +1062,15 @@ impl<'a, E: Engine> Run<'a, E> {
             warnings,
             evaluations: self.solver.evaluations(),
             settled,
+            accuracy: None,
             load_peaks: self.peaks.peaks().to_vec(),
+            latch_up_peaks: self.latch_up_peaks.peaks().to_vec(),
         }
     }
 }
+
+/// The scheduled stepper's longest step, as a fraction of the end time.
+const LONGEST_STEP: f64 = 0.01;
 
 /// The most points [`load_times`] gives one step (past it the step is not resolved).
 const MAX_LOAD_TIMES: f64 = 1e4;

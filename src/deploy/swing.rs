@@ -2,7 +2,7 @@
 //! would collide there; the model has no contact).
 
 use super::events::EVENT_TOL;
-use super::integrator::{locate, DenseStep};
+use crate::ode::integrator::{locate, DenseStep};
 use crate::warning::Warning;
 
 /// Margin below the initial angle that counts as a swing-back, rad.

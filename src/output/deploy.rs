@@ -128,14 +128,23 @@ pub(crate) fn impulse_scales(e: &crate::deploy::LatchEvent) -> (f64, f64) {
 fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
     let base = match d.base {
         BaseKind::Rigid => "rigid".to_string(),
-        BaseKind::Flexible { .. } if c.base.ritz.dof() <= 6 => {
+        BaseKind::Flexible { .. } | BaseKind::Corrected { .. } | BaseKind::Reduced { .. }
+            if c.base.ritz.dof() <= 6 =>
+        {
             "rigid (flexible asked, but it has no elastic component)".to_string()
         }
-        BaseKind::Flexible { .. } => format!(
-            "flexible, {} of {} hub-fixed modes",
-            c.modes(),
-            c.base.ritz.dof().saturating_sub(6)
-        ),
+        BaseKind::Flexible { .. } | BaseKind::Corrected { .. } | BaseKind::Reduced { .. } => {
+            format!(
+                "flexible, {} of {} hub-fixed modes{}",
+                c.modes() - c.base.correction,
+                c.base.ritz.dof().saturating_sub(6),
+                if c.base.correction > 0 {
+                    format!(" + {} static-correction vectors", c.base.correction)
+                } else {
+                    String::new()
+                }
+            )
+        }
     };
     let sync = match c.sync {
         Synchronisation::None => "none".to_string(),
@@ -143,6 +152,95 @@ fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
         Synchronisation::ElasticCable(k) => format!("cable ({k} N·m/rad per loop)"),
     };
     (base, sync)
+}
+
+/// The model and method the run used, and the automatic integrator's accuracy estimate.
+fn model_json(d: &Deployment, c: &Coupled, r: &DeploymentResult) -> Value {
+    let kept = c.modes() - c.base.correction;
+    let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+    let mut v = json!({
+        "integrator": integrator_name(d.integrator),
+        "base_modes_kept": kept,
+        "base_modes_available": c.base.ritz.dof().saturating_sub(6),
+        "kept_frequencies_hz": c.base.omega[..kept].iter().map(|w| hz(*w)).collect::<Vec<_>>(),
+        "static_correction_vectors": c.base.correction,
+        "static_correction_frequencies_hz": c.base.omega[kept..].iter().map(|w| hz(*w)).collect::<Vec<_>>(),
+    });
+    if let Some(a) = &r.accuracy {
+        v["cutoff_hz"] = json!(a.cutoff.map(hz));
+        v["step_rule"] = json!({"kappa": a.schedule.kappa, "delta_rad": a.schedule.delta});
+        v["accuracy"] = json!({
+            "asked": a.asked,
+            "estimate": if a.events_differ { Value::Null } else { json!(a.estimate) },
+            "reached": a.reached(),
+            "times": a.times,
+            "rates": a.rates,
+            "latch_moments": a.latch_moments,
+            "root_loads": a.root_loads,
+            "runs": a.runs,
+            "events_differ": a.events_differ,
+            "scope": if a.first_impact_only {
+                "the first impact's time and rate (after a rigid impact on an elastic base the outcome depends on the base modes kept)"
+            } else {
+                "every capture's time and rate, and the peak latch moments; root loads estimated"
+            },
+        });
+    }
+    v
+}
+
+/// The automatic integrator's model and accuracy in two lines (None for a named integrator).
+fn accuracy_line(c: &Coupled, r: &DeploymentResult) -> Option<String> {
+    let a = r.accuracy.as_ref()?;
+    let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
+    let kept = c.modes() - c.base.correction;
+    let cutoff = a
+        .cutoff
+        .map_or(String::new(), |w| format!(" (cutoff {:.3} Hz)", hz(w)));
+    let top = c.base.omega[..kept].iter().copied().fold(0.0, f64::max);
+    let model = format!(
+        "integrator auto: Rodas5P at steps set by each phase (κ = {:.3}, δ = {:.4} rad), the \
+         base's modes to {:.3} Hz{cutoff} resolved once excited, {} static-correction vectors \
+         quasi-static; {} runs, {} evaluations",
+        a.schedule.kappa,
+        a.schedule.delta,
+        hz(top),
+        c.base.correction,
+        a.runs,
+        a.evaluations
+    );
+    let scope = if a.first_impact_only {
+        "the first impact's time and rate (what follows an impact on an elastic base depends on \
+         the base modes kept)"
+    } else {
+        "capture times and rates, peak latch moments"
+    };
+    let estimate = if a.events_differ {
+        "the last two runs differ in their events: no estimate".to_string()
+    } else {
+        format!(
+            "estimate {:.1e} (asked {:.0e}{}): times {:.1e}, rates {:.1e}, latch moments {:.1e}; \
+             root loads {:.1e} (estimated, not bounded)",
+            a.estimate,
+            a.asked,
+            if a.reached() { "" } else { ", NOT reached" },
+            a.times,
+            a.rates,
+            a.latch_moments,
+            a.root_loads
+        )
+    };
+    Some(format!("{model}\naccuracy of {scope}: {estimate}"))
+}
+
+/// The integrator's name as the scenario spells it.
+fn integrator_name(i: crate::deploy::Integrator) -> &'static str {
+    match i {
+        crate::deploy::Integrator::Auto => "auto",
+        crate::deploy::Integrator::Explicit => "explicit",
+        crate::deploy::Integrator::Implicit => "implicit",
+        crate::deploy::Integrator::Adiabatic => "adiabatic",
+    }
 }
 
 /// The deployment result as one JSON object (`--json` and events.json).
@@ -203,6 +301,7 @@ pub fn deploy_json(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResult
         "peak_root_loads": peak_root_loads(c, r),
         "peak_hinge_reactions": peak_hinge_reactions(c, r),
         "peak_latch_moments": peak_latch_moments(r),
+        "model": model_json(d, c, r),
     });
     serde_json::to_string_pretty(&v).unwrap_or_default()
 }
@@ -224,6 +323,9 @@ pub fn deploy_table(name: &str, d: &Deployment, c: &Coupled, r: &DeploymentResul
         d.chain.len(),
         latching_name(d.latching)
     );
+    if let Some(line) = accuracy_line(c, r) {
+        let _ = writeln!(s, "{line}");
+    }
     let show = d.chain.len().min(12);
     for e in &r.latches {
         let _ = writeln!(

@@ -20,8 +20,10 @@ use crate::structure::Structure;
 pub const DEFAULT_END_TIME: f64 = 300.0;
 /// Default sample rate, Hz.
 pub const DEFAULT_OUTPUT_RATE: f64 = 10.0;
-/// Default relative integration tolerance.
+/// Default relative integration tolerance of the named integrators.
 pub const DEFAULT_TOLERANCE: f64 = 1e-10;
+/// Default results accuracy of the automatic integrator (relative).
+pub const DEFAULT_ACCURACY: f64 = 1e-3;
 
 /// Builds the deployment from `[deployment]` and the structure: the deploying plate, its
 /// panels and hinges, the run settings; the chain itself comes from
@@ -104,13 +106,17 @@ pub(super) fn lower(
     let (end_time, output_rate, tolerance) = run_settings(cx, raw)?;
     let synchronisation = synchronisation(cx, raw, &chain.hinges)?;
     let latch = latch(cx, raw, chain.len())?;
+    let integrator = match d.integrator.as_ref().map(|i| *i.get_ref()) {
+        Some(RawIntegrator::Implicit) => Integrator::Implicit,
+        Some(RawIntegrator::Adiabatic) => Integrator::Adiabatic,
+        Some(RawIntegrator::Explicit) => Integrator::Explicit,
+        Some(RawIntegrator::Auto) | None => Integrator::Auto,
+    };
+    let accuracy = accuracy(cx, raw, integrator)?;
     Ok(Deployment {
         latch,
-        integrator: match d.integrator.as_ref().map(|i| *i.get_ref()) {
-            Some(RawIntegrator::Implicit) => Integrator::Implicit,
-            Some(RawIntegrator::Adiabatic) => Integrator::Adiabatic,
-            _ => Integrator::Explicit,
-        },
+        integrator,
+        accuracy,
         base: base(cx, raw)?,
         base_damping_ratio: base_damping_ratio(cx, raw)?,
         synchronisation,
@@ -544,6 +550,43 @@ fn common_hinge(
         L::HINGE_FRICTION,
     )?;
     Ok((k_all, preload, damping_all, friction_all))
+}
+
+/// `accuracy` (the automatic integrator's) and the refusal of `tolerance` with it: each key
+/// belongs to its integrators.
+fn accuracy(
+    cx: &Ctx,
+    raw: &S<RawDeployment>,
+    integrator: Integrator,
+) -> Result<f64, ScenarioError> {
+    let d = raw.get_ref();
+    if integrator == Integrator::Auto {
+        if let Some(t) = &d.tolerance {
+            return Err(cx.invalid(
+                t.span(),
+                "deployment.tolerance",
+                "the automatic integrator (integrator = \"auto\", the default) sets its steps \
+                 itself and bounds the results' error by [deployment] accuracy: give accuracy \
+                 instead, or name an integrator (\"explicit\", \"implicit\", \"adiabatic\") \
+                 to set its tolerance",
+            ));
+        }
+        return cx.bounded_or(
+            &d.accuracy,
+            DEFAULT_ACCURACY,
+            "deployment.accuracy",
+            L::ACCURACY,
+        );
+    }
+    if let Some(a) = &d.accuracy {
+        return Err(cx.invalid(
+            a.span(),
+            "deployment.accuracy",
+            "accuracy is the automatic integrator's (integrator = \"auto\", the default); a \
+             named integrator takes tolerance: remove accuracy or the integrator key",
+        ));
+    }
+    Ok(DEFAULT_ACCURACY)
 }
 
 /// End time, output rate (with the row cap) and tolerance.

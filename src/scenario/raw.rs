@@ -197,6 +197,7 @@ pub struct RawDeployment {
     pub end_time: Option<S<f64>>,
     pub output_rate: Option<S<f64>>,
     pub tolerance: Option<S<f64>>,
+    pub accuracy: Option<S<f64>>,
     pub panel_mass: Option<S<f64>>,
     pub panel_inertia: Option<S<f64>>,
     pub hinge: Option<S<RawHingeAll>>,
@@ -237,6 +238,7 @@ pub enum RawPerHinge {
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
 pub enum RawIntegrator {
+    Auto,
     Implicit,
     Adiabatic,
     Explicit,

@@ -240,6 +240,7 @@ plate = "wing"
 panels = 1
 end_time = 20.0
 output_rate = {output_rate:?}
+integrator = "explicit"
 tolerance = {tolerance:e}
 [deployment.hinge]
 stiffness = 3.0

@@ -1184,6 +1184,7 @@ fn rigid_mast_limit_agrees_with_the_rigid_chain() {
         latch: flexcraft::deploy::LatchModel::Rigid,
         base_damping_ratio: 0.0,
         tolerance: 1e-12,
+        accuracy: 1e-3,
     });
     assert_eq!(
         mine.latches.len(),

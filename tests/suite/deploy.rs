@@ -54,6 +54,7 @@ pub fn deployment(chain: Chain, latching: Latching, tol: f64) -> Deployment {
         latch: flexcraft::deploy::LatchModel::Rigid,
         base_damping_ratio: 0.0,
         tolerance: tol,
+        accuracy: 1e-3,
     }
 }
 

@@ -447,7 +447,7 @@ fn derived_panels_obey_the_ranges_of_given_ones() {
 fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
     let dir = scratch("coupled-keys");
     let sync = "synchronisation = \"cable\"\n";
-    let cases: [(String, &str, &str, &str); 9] = [
+    let cases: [(String, &str, &str, &str); 13] = [
         (
             SEED.replace(sync, &format!("{sync}hub = \"free\"\n")),
             "hub = \"free\"",
@@ -455,7 +455,7 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
             "[hub] motion",
         ),
         (
-            SEED.replace("base_modes = 6", "base_modes = -1"),
+            SEED.replace(sync, &format!("{sync}base_modes = -1\n")),
             "base_modes = -1",
             "deployment.base_modes",
             "0 or more",
@@ -479,7 +479,7 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
             "twice as far",
         ),
         (
-            SEED.replace("base = \"flexible\"", "base = \"rigid\""),
+            SEED.replace("base = \"flexible\"", "base = \"rigid\"\nbase_modes = 6"),
             "base_modes = 6",
             "deployment.base_modes",
             "rigid base",
@@ -497,10 +497,35 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
             "[0, 1)",
         ),
         (
-            SEED.replace("base = \"flexible\"\nbase_modes = 6", "base = \"rigid\"\nbase_damping_ratio = 0.01"),
+            SEED.replace("base = \"flexible\"", "base = \"rigid\"\nbase_damping_ratio = 0.01"),
             "base_damping_ratio = 0.01",
             "deployment.base_damping_ratio",
             "rigid base",
+        ),
+        // The automatic integrator (the default) takes accuracy, the named ones tolerance.
+        (
+            SEED.replace(sync, &format!("{sync}tolerance = 1e-8\n")),
+            "tolerance = 1e-8",
+            "deployment.tolerance",
+            "give accuracy instead",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}integrator = \"explicit\"\naccuracy = 1e-4\n")),
+            "accuracy = 1e-4",
+            "deployment.accuracy",
+            "named integrator takes tolerance",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}accuracy = 0.5\n")),
+            "accuracy = 0.5",
+            "deployment.accuracy",
+            "[1e-8, 0.1]",
+        ),
+        (
+            SEED.replace(sync, &format!("{sync}accuracy = 1e-9\n")),
+            "accuracy = 1e-9",
+            "deployment.accuracy",
+            "[1e-8, 0.1]",
         ),
     ];
     for (k, (src, needle, key, reason)) in cases.iter().enumerate() {
@@ -518,7 +543,10 @@ fn coupled_deployment_keys_are_refused_or_clamped_with_location() {
     assert!(err.contains("`panels`") && !err.contains("`hub`"), "{err}");
     // Above the base's count: clamped, with the warning.
     let sc = Scenario::from_toml_str(
-        &SEED.replace("base_modes = 6", "base_modes = 500"),
+        &SEED.replace(
+            "synchronisation = \"cable\"\n",
+            "synchronisation = \"cable\"\nbase_modes = 500\n",
+        ),
         "s.toml",
     )
     .unwrap();

@@ -202,6 +202,7 @@ terms = {{ length = 8, width = 4 }}
 plate = "wing"
 panels = 3
 latching = "{latching}"
+integrator = "explicit"
 tolerance = 1e-13              # two formulations integrated: agree to 1e-9 below
 [deployment.hinge]
 stiffness = 3.0

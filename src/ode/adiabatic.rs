@@ -55,6 +55,7 @@
 use super::integrator::{
     difference_columns, differenced_columns, Change, DenseStep, OdeSystem, Tie,
 };
+use super::restore::Restorer;
 use super::rosenbrock::{forward_jacobian, Rodas5P};
 use faer::linalg::solvers::Solve;
 use faer::{c64, Mat};
@@ -542,12 +543,6 @@ fn projected(
     let ((f, fast), (fs, fast_s)) = (size(y), size(ys));
     fs <= 10.0 * f && fast_s <= fast + 1e-6 * f
 }
-
-/// Steps over which the invariants' Jacobian is kept ([`Adiabatic::step`]).
-const RESTORE_REFRESH: usize = 16;
-
-/// Newton iterations restoring the invariants at most ([`Adiabatic::conserve`]).
-const RESTORE_ITERATIONS: usize = 4;
 
 /// The least |w_oldᵀ v_new| |w_newᵀ v_old| (1 for an unchanged mode) at which a mode is
 /// matched across a step.
@@ -1083,18 +1078,11 @@ pub struct Adiabatic {
     forcing_slope: Option<Vec<f64>>,
     /// `forcing` is the split's (per-pair differences), not a step end's (phase sampling).
     forcing_from_split: bool,
-    /// The conserved quantities at the first split ([`OdeSystem::invariants`]), restored
-    /// after every step; empty when the system has none.
-    target: Vec<f64>,
-    /// ∂(invariants)/∂(their coordinates), kept while it serves (`restore`).
-    invariant_jacobian: Option<Mat<f64>>,
+    /// The conserved quantities, restored after every step.
+    restorer: Restorer,
     /// The slow state was corrected after the last step: Rodas5P's derivative there is
     /// stale.
     moved: bool,
-    /// Restorations since the invariants' Jacobian was differenced.
-    restore_age: usize,
-    /// The invariants' residual (max norm) found by the last restoration.
-    restore_residual: f64,
     /// The number of fast eigenvalues at the last split (the ringing carries the excited
     /// ones): each step end's modes are matched among as many.
     fast_count: usize,
@@ -1119,11 +1107,8 @@ impl Adiabatic {
             forcing_slope: None,
             forcing_from_split: false,
             fast_count: 0,
-            target: Vec::new(),
-            invariant_jacobian: None,
+            restorer: Restorer::default(),
             moved: false,
-            restore_age: 0,
-            restore_residual: f64::INFINITY,
             extra_evaluations: 0,
         }
     }
@@ -1139,7 +1124,7 @@ impl Adiabatic {
 
     /// Right-hand-side evaluations so far.
     pub fn evaluations(&self) -> usize {
-        self.slow.evaluations + self.extra_evaluations
+        self.slow.evaluations + self.extra_evaluations + self.restorer.evaluations
     }
 
     /// J at y by forward differences (Rodas5P's).
@@ -1157,12 +1142,10 @@ impl Adiabatic {
         // Rodas5P's derivative belongs to the old point (a split after a failed step comes
         // without its restart).
         self.moved = true;
-        if self.target.is_empty() {
-            // At the run's start: impacts and captures conserve them (internal impulses), and
-            // a state located on a step's dense output carries that step's own error.
-            self.target = sys.invariants(y);
-        }
-        self.invariant_jacobian = None;
+        // At the run's start: impacts and captures conserve them (internal impulses), and
+        // a state located on a step's dense output carries that step's own error.
+        self.restorer.start(sys, y);
+        self.restorer.forget_jacobian();
         self.fresh = false;
         self.ringing = None;
         self.forcing = None;
@@ -1317,110 +1300,6 @@ impl Adiabatic {
         })
     }
 
-    /// Restores the conserved quantities ([`OdeSystem::invariants`]) in `y` through their
-    /// coordinates, by Newton's method on their exact linear dependence (the correction is
-    /// returned, to be applied to the slow state too). The slow run and the ringing each
-    /// conserve the free spacecraft's momentum only to their truncation: measured on the
-    /// seed with compliant latches, the ringing's first-order approximation lets P drift to
-    /// 4.6e-3 N·s in the second after the capture, while the latch mode (15.6 rad/s) is not
-    /// slow against the mast's (109 rad/s). Restoring it after every step is a projection
-    /// method (Hairer, Lubich & Wanner, Geometric Numerical Integration, IV.4): it keeps the
-    /// order and holds the invariants at every step's end, up to what the Jacobian's age
-    /// leaves.
-    ///
-    /// After a step (`tight` false) one iteration with the kept Jacobian (differenced afresh
-    /// after [`RESTORE_REFRESH`] restorations, or when the residual has grown fourfold since
-    /// the last) removes most of the step's error, and what is left is removed with the next
-    /// step's: nothing accumulates while the Jacobian contracts. At an event (`tight`) the
-    /// iterations go on to rounding. The step's dense output takes the correction spread
-    /// linearly over the step ([`Adiabatic::step`]), so that it stays continuous.
-    fn restore(&mut self, sys: &dyn OdeSystem, y: &mut [f64], tight: bool) -> Vec<(usize, f64)> {
-        if self.target.is_empty() {
-            return Vec::new();
-        }
-        self.restore_age += 1;
-        if self.restore_age > RESTORE_REFRESH {
-            self.invariant_jacobian = None;
-        }
-        let coords = sys.invariant_coordinates();
-        let residual = |y: &[f64]| -> Vec<f64> {
-            self.target
-                .iter()
-                .zip(sys.invariants(y))
-                .map(|(t, v)| t - v)
-                .collect()
-        };
-        let mut r = residual(y);
-        self.extra_evaluations += 1;
-        // A residual growing from step to step means the kept Jacobian no longer contracts
-        // it (the inertia has changed): difference it afresh.
-        let growing = max_norm(&r) > 4.0 * self.restore_residual;
-        self.restore_residual = max_norm(&r);
-        if growing && self.restore_age > 0 {
-            self.invariant_jacobian = None;
-        }
-        let before: Vec<f64> = coords.iter().map(|&k| y[k]).collect();
-        // Newton on an exactly linear dependence: one iteration with a fresh Jacobian
-        // leaves rounding; a kept one (from an earlier configuration) contracts by its
-        // change, so iterate while that pays, and refresh it when it no longer contracts
-        // by 1e-3.
-        for _ in 0..if tight { RESTORE_ITERATIONS } else { 1 } {
-            if max_norm(&r) == 0.0 {
-                break;
-            }
-            let g = match self.invariant_jacobian.take() {
-                Some(g) => g,
-                None => {
-                    // Linear in the coordinates: a unit difference is exact.
-                    let base: Vec<f64> = sys.invariants(y);
-                    let mut g = Mat::<f64>::zeros(base.len(), coords.len());
-                    let mut yp = y.to_vec();
-                    for (c, &k) in coords.iter().enumerate() {
-                        yp[k] += 1.0;
-                        for (row, (a, b)) in sys.invariants(&yp).iter().zip(&base).enumerate() {
-                            g[(row, c)] = a - b;
-                        }
-                        yp[k] = y[k];
-                    }
-                    self.extra_evaluations += coords.len() + 1;
-                    self.restore_age = 0;
-                    g
-                }
-            };
-            let rhs = Mat::<f64>::from_fn(r.len(), 1, |i, _| r[i]);
-            let step = g.partial_piv_lu().solve(&rhs);
-            if !(0..coords.len()).all(|c| step[(c, 0)].is_finite()) {
-                break;
-            }
-            let kept: Vec<f64> = coords.iter().map(|&k| y[k]).collect();
-            for (c, &k) in coords.iter().enumerate() {
-                y[k] += step[(c, 0)];
-            }
-            if !tight {
-                self.invariant_jacobian = Some(g);
-                break;
-            }
-            let next = residual(y);
-            self.extra_evaluations += 1;
-            if max_norm(&next) >= max_norm(&r) {
-                // Rounding reached (or a useless Jacobian): undo this iteration.
-                for (&k, v) in coords.iter().zip(kept) {
-                    y[k] = v;
-                }
-                break;
-            }
-            if max_norm(&next) <= 1e-3 * max_norm(&r) {
-                self.invariant_jacobian = Some(g);
-            }
-            r = next;
-        }
-        coords
-            .iter()
-            .zip(before)
-            .map(|(&k, b)| (k, y[k] - b))
-            .collect()
-    }
-
     /// One accepted step from (t, y) towards at most `t_end`: y is the whole state (slow +
     /// ringing) before and after; the dense output carries both. The conserved quantities
     /// are restored at the step's end (`restore`).
@@ -1432,7 +1311,7 @@ impl Adiabatic {
         t_end: f64,
     ) -> DenseStep {
         let mut dense = self.advance(sys, t, y, t_end);
-        let correction = self.restore(sys, y, false);
+        let correction = self.restorer.restore(sys, y, false);
         for &(k, d) in &correction {
             dense.add_linear(k, d);
         }
@@ -1452,7 +1331,7 @@ impl Adiabatic {
     /// Restores the conserved quantities in a state taken from a step's dense output (an
     /// event's: the dense output between step ends carries the step's own error).
     pub fn conserve(&mut self, sys: &dyn OdeSystem, y: &mut [f64]) {
-        self.restore(sys, y, true);
+        self.restorer.restore(sys, y, true);
     }
 
     /// [`Adiabatic::step`] before the invariants are restored.
@@ -1577,7 +1456,7 @@ impl Adiabatic {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deploy::integrator::Dopri5;
+    use crate::ode::integrator::Dopri5;
 
     /// Two oscillators whose frequencies drift slowly with a slow coordinate s (ṡ = σ),
     /// coupled through s: y = (x1, x2, v1, v2, s), ω1 = 40 (1 + s), ω2 = 90 (1 + s/2),

@@ -316,14 +316,50 @@ impl Rodas5P {
         y: &mut [f64],
         t_end: f64,
     ) -> DenseStep {
+        self.advance(sys, t, y, t_end, None)
+    }
+
+    /// dy/dt at (t, y), the state the next step starts from (evaluated once per step: the
+    /// step reuses it).
+    pub fn derivative(&mut self, sys: &dyn OdeSystem, t: f64, y: &[f64]) -> &[f64] {
         let n = y.len();
         if self.fresh || self.f0.len() != n {
             self.f0 = vec![0.0; n];
-            sys.rhs(*t, y, &mut self.f0);
+            sys.rhs(t, y, &mut self.f0);
             self.evaluations += 1;
             self.h = self.initial_step(y);
             self.fresh = false;
         }
+        &self.f0
+    }
+
+    /// One step of length `h` (or to `t_end` if that is nearer), accepted whatever its error
+    /// estimate: the caller sets the steps from what the motion must resolve, and the method's
+    /// L-stability (R(∞) = 0) damps what they do not resolve — modes with ω h ≫ 1 follow
+    /// their quasi-static solution after a few steps, as in structural dynamics' implicit
+    /// integrators with high-frequency dissipation (Hilber, Hughes & Taylor 1977; Chung &
+    /// Hulbert 1993). A step that is not finite returns as such (the caller stops there).
+    pub fn step_scheduled(
+        &mut self,
+        sys: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_end: f64,
+        h: f64,
+    ) -> DenseStep {
+        self.advance(sys, t, y, t_end, Some(h))
+    }
+
+    fn advance(
+        &mut self,
+        sys: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_end: f64,
+        scheduled: Option<f64>,
+    ) -> DenseStep {
+        let n = y.len();
+        self.derivative(sys, *t, y);
         let jac = {
             let mut j = Mat::zeros(n, n);
             if sys.jacobian(*t, y, &mut j) {
@@ -341,7 +377,7 @@ impl Rodas5P {
         let mut rhs = Mat::<f64>::zeros(n, 1);
         let mut f1 = vec![0.0; n];
         loop {
-            let mut h = self.h.min(self.h_max);
+            let mut h = scheduled.unwrap_or_else(|| self.h.min(self.h_max));
             let last = *t + h >= t_end - 1e-12 * t_end.abs().max(1.0);
             if last {
                 h = t_end - *t;
@@ -396,7 +432,7 @@ impl Rodas5P {
             } else {
                 0.2
             };
-            if err <= 1.0 || h.abs() < 1e-14 * t.abs().max(1.0) {
+            if scheduled.is_some() || err <= 1.0 || h.abs() < 1e-14 * t.abs().max(1.0) {
                 sys.rhs(*t + h, &y1, &mut f1);
                 self.evaluations += 1;
                 // Cubic Hermite in DenseStep's form: r1 = Δ, r2 = h f0 − Δ,
