@@ -4,8 +4,13 @@
 
 #![allow(clippy::needless_range_loop)]
 
+mod support {
+    pub mod spacecraft;
+}
+
 mod suite {
     pub mod adiabatic;
+    pub mod any_spacecraft;
     pub mod array_files;
     pub mod beam_functions;
     pub mod cli;

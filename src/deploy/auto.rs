@@ -2,9 +2,8 @@
 //! accuracy (docs/theory.md §2.9, `[deployment] integrator = "auto"`, the default).
 //!
 //! The model: the base keeps its hub-fixed modes up to a cutoff ω_c = μ ω_a, ω_a the
-//! array's fastest motion ([`super::timescales::fastest`]: its hinge springs, cable and, with
-//! compliant latches, its latch springs, base held), plus the static correction of the modes
-//! above ([`super::static_correction`]). The method: Rodas5P at steps set by the phase
+//! array's fastest motion ([`super::timescales::fastest`]: its hinge springs and cable, base
+//! held), plus the static correction of the modes above ([`super::static_correction`]). The method: Rodas5P at steps set by the phase
 //! ([`super::Schedule`]): κ/ω of the array's fastest motion in the phase, and at most a
 //! turn δ of any opening hinge; the base's vibration above 1/h follows its quasi-static
 //! solution.
@@ -101,11 +100,10 @@ fn base_at(d: &Deployment, margin: f64, at_least: usize) -> (BaseKind, Option<f6
             (BaseKind::Corrected { modes: m.max(1) }, None)
         }
         BaseKind::Flexible { modes: None } | BaseKind::Reduced { .. } => {
-            let latch: Vec<f64> = match &d.latch {
-                LatchModel::Compliant { stiffness, .. } => stiffness.clone(),
-                LatchModel::Rigid => Vec::new(),
-            };
-            let fastest = super::timescales::fastest(&d.chain, &latch, d.synchronisation, &[]);
+            // The array on its hinge springs and cable: a latch-up's faster vibration is
+            // resolved by the steps while it lasts, and with it the correction's vectors
+            // below 1/h (the base's quasi-static and first dynamic response to the latch).
+            let fastest = super::timescales::fastest(&d.chain, &[], d.synchronisation, &[]);
             let cutoff = margin * fastest;
             (BaseKind::Reduced { cutoff, at_least }, Some(cutoff))
         }

@@ -4,7 +4,7 @@
 //! planar chain ([`PlanarEngine`], the rigid reference) or the coupled model
 //! ([`super::coupled::Coupled`]).
 
-use super::chain::{Chain, Hinge, PlanarHub, P2};
+use super::chain::{Chain, Hinge, PlanarHub, FRICTION_RATE, P2};
 use super::events::{self, Crossing};
 use super::peaks::PeakTracker;
 use super::swing::SwingTracker;
@@ -283,6 +283,7 @@ impl Scheduled {
         t_end: f64,
         open_rates: std::ops::Range<usize>,
         open: &[bool],
+        rubbing: &[bool],
     ) -> DenseStep {
         self.restorer.start(sys, y);
         let f = self.rodas.derivative(sys, *t, y);
@@ -295,6 +296,16 @@ impl Scheduled {
                 h = h
                     .min(self.rule.delta / y[k].abs())
                     .min((2.0 * self.rule.delta / f[k].abs()).sqrt());
+                // Coulomb friction is regularised linearly below FRICTION_RATE: a stiff
+                // damping there, which a long step linearises across the whole step and
+                // holds the hinge back (a panel released from rest latched 0.53 s late). A
+                // hinge with friction changes its rate by at most half of it per step (or
+                // of 10 FRICTION_RATE), so that it leaves the band within a few short steps
+                // and stays in it only where it truly sticks (where α̈ ≈ 0).
+                if rubbing.get(j).copied().unwrap_or(false) {
+                    let scale = y[k].abs().max(10.0 * FRICTION_RATE);
+                    h = h.min(0.5 * scale / f[k].abs());
+                }
             }
         }
         let mut dense = self.rodas.step_scheduled(sys, t, y, t_end, h);
@@ -343,7 +354,7 @@ impl Stepper {
             Self::Implicit(s) => s.step(sys, t, y, t_end),
             Self::Adiabatic(s) => s.step(sys, t, y, t_end),
             // The run calls Scheduled::step itself (it needs the open hinges).
-            Self::Scheduled(s) => s.step(sys, t, y, t_end, 0..0, &[]),
+            Self::Scheduled(s) => s.step(sys, t, y, t_end, 0..0, &[], &[]),
         }
     }
     /// A state taken from the dense output (an event's) with its conserved quantities
@@ -533,16 +544,17 @@ impl<'a, E: Engine> Run<'a, E> {
             }
             None => self.sys.engine.array_fastest(&open, &[]),
         };
-        // The base's kept modes are resolved from the first impact or capture on: each
-        // excites them, and in an undamped base their vibration lasts and reaches the later
-        // events (a hinge creeping into its latch meets the base still ringing from the
-        // earlier latch-ups). Before it only the release has (a step of the hinge springs'
-        // moments, small against a latch-up's), and steps set by the array let that
-        // vibration settle quasi-statically.
-        let base = if self.last_event.is_finite() {
-            self.sys.engine.base_resolved()
-        } else {
+        // The base's kept modes are resolved from the first capture on: a latch-up excites
+        // them, and in an undamped base their vibration lasts and reaches the later events (a
+        // hinge creeping into its latch meets the base still ringing from the earlier
+        // latch-ups). Before it only the release has (a step of the hinge springs' moments,
+        // small against a latch-up's), and after a rigid impact the base's motion depends on
+        // the modes kept anyway (no continuum limit, docs/theory.md §2.3): steps set by the
+        // array let that vibration settle quasi-statically.
+        let base = if self.captures.is_empty() {
             0.0
+        } else {
+            self.sys.engine.base_resolved()
         };
         if let Stepper::Scheduled(s) = &mut self.solver {
             s.omega = omega.max(base);
@@ -721,6 +733,13 @@ impl<'a, E: Engine> Run<'a, E> {
             Stepper::Scheduled(s) => {
                 let ro = self.sys.engine.positions() + self.sys.engine.rate_offset();
                 let open = self.sys.open();
+                let rubbing: Vec<bool> = self
+                    .sys
+                    .engine
+                    .hinges()
+                    .iter()
+                    .map(|h| h.friction > 0.0)
+                    .collect();
                 s.step(
                     &self.sys,
                     &mut self.t,
@@ -728,6 +747,7 @@ impl<'a, E: Engine> Run<'a, E> {
                     t_stop,
                     ro..ro + open.len(),
                     &open,
+                    &rubbing,
                 )
             }
             solver => solver.step(&self.sys, &mut self.t, &mut self.y, t_stop),

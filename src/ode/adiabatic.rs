@@ -42,7 +42,7 @@
 //!
 //! What is left out: the terms of third order in δ, and the non-adiabatic coupling, O(ε) of
 //! the ringing with ε the slow rates over the fast frequencies. Measured on the seed with 20
-//! base modes against RK4 at h = 5 µs (`examples/slow_manifold_study.rs`, 2026-11-25,
+//! base modes against RK4 at h = 5 µs (`studies/slow_manifold_study.rs`, 2026-11-25,
 //! before the slow run's tolerance on η̇ was scaled by ω,
 //! [`OdeSystem::slow_tolerance_scales`]): to 20 s in 16 slow steps, α to 1.7e-11 rad and ω·η
 //! to 3.0e-7 against a ringing of 5.4e-4; to 55 s in 90, 3.8e-9 rad and 7.7e-8 (DOPRI5 at

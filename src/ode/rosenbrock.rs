@@ -21,7 +21,7 @@
 //! step anyway. Once the state is on the slow manifold (no ringing) the stiff part is not
 //! enough: Rodas5P is not a W-method, and the left-out terms cost it its stability on the
 //! fast modes, so its step shrinks with the panels' speed (seed, 20 modes: 38 707 steps
-//! against 195 with the full Jacobian; `examples/slow_manifold_study.rs`). Modes far above
+//! against 195 with the full Jacobian; `studies/slow_manifold_study.rs`). Modes far above
 //! 1/h are damped by the method (R(∞) = 0): that is the price of a step set by the slow
 //! motion, and it is why `integrator = "explicit"` (DOPRI5) stays available for
 //! conservation checks on few modes.

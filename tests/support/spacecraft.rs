@@ -21,16 +21,6 @@ pub struct Drawn {
     pub toml: String,
     /// A free hub.
     pub free_hub: bool,
-    /// Number of panels.
-    pub panels: usize,
-    /// Tied by an ideal cable.
-    pub cable: bool,
-    /// Compliant latches.
-    pub compliant: bool,
-    /// The panels' total mass, kg.
-    pub wing_mass: f64,
-    /// The wing's length, m.
-    pub wing_length: f64,
 }
 
 struct Draw(ChaCha8Rng);
@@ -111,7 +101,10 @@ pub fn spacecraft(seed: u64) -> Drawn {
     let mut d = Draw(ChaCha8Rng::seed_from_u64(seed));
     let mut t = String::new();
     let free_hub = d.coin(0.6);
-    let _ = writeln!(t, "name = \"random spacecraft {seed}\"\nformat_version = 1\n");
+    let _ = writeln!(
+        t,
+        "name = \"random spacecraft {seed}\"\nformat_version = 1\n"
+    );
     // The hub: a box of 0.5 to 3 m sides and 50 kg to 5 t.
     let hub_mass = d.log(50.0, 5000.0);
     let sides = [d.range(0.5, 3.0), d.range(0.5, 3.0), d.range(0.5, 3.0)];
@@ -233,7 +226,11 @@ pub fn spacecraft(seed: u64) -> Drawn {
     let _ = writeln!(t, "[[plates]]\nname = \"wing\"");
     let (la, normal) = if on_hub {
         let la = d.direction();
-        let root = [la[0] * sides[0] / 2.0, la[1] * sides[1] / 2.0, la[2] * sides[2] / 2.0];
+        let root = [
+            la[0] * sides[0] / 2.0,
+            la[1] * sides[1] / 2.0,
+            la[2] * sides[2] / 2.0,
+        ];
         let _ = writeln!(t, "parent = \"hub\"\nroot = {}", v3(root));
         (la, d.perpendicular(la))
     } else {
@@ -285,15 +282,16 @@ pub fn spacecraft(seed: u64) -> Drawn {
     let rubbing = d.coin(0.3);
     let _ = writeln!(t, "\n[deployment.hinge]\npreload_angle = {preload:?}");
     let _ = writeln!(t);
+    // Equal springs on the interior hinges, as in most arrays, set against the outermost
+    // panels' inertia; the root hinge's against the whole wing's.
+    let k_inner = {
+        let out: f64 = lengths[1.min(panels - 1)..].iter().sum();
+        (areal * width * out * out * out / 3.0) * (PI / (2.0 * t_dep)).powi(2) * d.log(0.5, 2.0)
+    };
     for i in 0..panels {
-        // Each hinge's spring sized for what it swings: the panels outboard of it.
+        let k = if i == 0 { k_root } else { k_inner };
         let out: f64 = lengths[i..].iter().sum();
         let m_out = areal * width * out;
-        let k = if i == 0 {
-            k_root
-        } else {
-            (m_out * out * out / 3.0) * (PI / (2.0 * t_dep)).powi(2) * d.log(0.5, 2.0)
-        };
         let _ = writeln!(t, "[[deployment.hinges]]\nstiffness = {k:?}");
         if damped {
             let c = 2.0 * d.range(0.01, 0.3) * (k * m_out * out * out / 3.0).sqrt();
@@ -315,13 +313,5 @@ pub fn spacecraft(seed: u64) -> Drawn {
             "\n[deployment.latch]\nmodel = \"compliant\"\nstiffness = {k:?}\ndamping = {c:?}"
         );
     }
-    Drawn {
-        toml: t,
-        free_hub,
-        panels,
-        cable,
-        compliant,
-        wing_mass,
-        wing_length,
-    }
+    Drawn { toml: t, free_hub }
 }

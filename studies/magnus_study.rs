@@ -27,7 +27,8 @@
 //! The error is measured against classical RK4 with a fixed step far below the highest
 //! period (cached in `target/magnus_study/`), and DOPRI5 (the library's explicit
 //! integrator, through `simulate_coupled`) at the given tolerances is measured the same way.
-//! Run: `cargo run --release --example magnus_study -- 20 20 mm-smooth 1 0.5 0.25`
+//! Run: `cargo run --release --example magnus_study -- 20 20 mm-smooth 1 0.5 0.25` (without
+//! arguments: `4 2 mm-smooth 0.05 0.025`, a few seconds)
 //! (base modes, t_end, method, fixed steps…); `--tol 1e-8` adds a run whose step is
 //! controlled on the Richardson pair (one step h against two of h/2), `--dopri 1e-8` DOPRI5 at
 //! that tolerance. The first run for a (modes, t_end) pair computes the reference: about 4
@@ -304,7 +305,16 @@ fn errors(p: &Problem, y: &[f64], r: &[f64]) -> [f64; 4] {
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    if args.is_empty() {
+        // Without arguments, a short demonstration: 4 base modes for 2 s, the modified
+        // Magnus method at two steps against the RK4 reference.
+        args = ["4", "2", "mm-smooth", "0.05", "0.025"]
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        println!("(no arguments: magnus_study {})", args.join(" "));
+    }
     let modes: usize = args.first().ok_or("base modes")?.parse()?;
     let t_end: f64 = args.get(1).ok_or("t_end")?.parse()?;
     let method = args.get(2).ok_or("method")?.as_str();
@@ -324,8 +334,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             hs.push(a.parse::<f64>()?);
         }
     }
-    let text = std::fs::read_to_string("examples/seed.toml")?
-        .replace("base_modes = 6", &format!("base_modes = {modes}"));
+    let text = std::fs::read_to_string("examples/seed.toml")?.replace(
+        "synchronisation = \"cable\"\n",
+        &format!("synchronisation = \"cable\"\nbase_modes = {modes}\n"),
+    );
     let sc = Scenario::from_toml_str(&text, "seed.toml")?;
     let d: Deployment = sc.deployment.clone().ok_or("no deployment")?;
     let c = d.coupled(&sc.structure)?;

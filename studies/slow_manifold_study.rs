@@ -15,7 +15,7 @@
 //!   takes out, the ringing, is not propagated.
 //! * **`--ringing T_END`**: the library's adiabatic stepper (`integrator = "adiabatic"`: the
 //!   slow run plus the ringing carried mode by mode) and the slow run alone, to T_END, against
-//!   the RK4 reference that `examples/magnus_study.rs` caches for (modes, T_END).
+//!   the RK4 reference that `studies/magnus_study.rs` caches for (modes, T_END).
 //!
 //! Run: `cargo run --release --example slow_manifold_study -- 20 1e-8 project fd`
 //! (base modes, tolerance, `project` | `release`, `fd` | `stiff` [, `--ringing 55`]).
@@ -62,7 +62,7 @@ fn errors(c: &Coupled, y: &[f64], r: &[f64]) -> [f64; 4] {
 }
 
 /// The library's adiabatic stepper (`integrator = "adiabatic"`) to `t_end`, against the RK4
-/// reference that `examples/magnus_study.rs` cached for (modes, t_end); beside it the slow
+/// reference that `studies/magnus_study.rs` cached for (modes, t_end); beside it the slow
 /// run alone (the state projected, no ringing).
 fn ringing_run(
     s: &Sys,
@@ -111,14 +111,25 @@ fn ringing_run(
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
     let usage = "usage: slow_manifold_study MODES TOL project|release fd|stiff [--ringing T_END]";
+    if args.is_empty() {
+        // Without arguments, a short demonstration (4 base modes, the projected start, the
+        // stiff Jacobian).
+        args = ["4", "1e-8", "project", "stiff"]
+            .iter()
+            .map(ToString::to_string)
+            .collect();
+        println!("(no arguments: slow_manifold_study {})", args.join(" "));
+    }
     let modes: usize = args.first().ok_or(usage)?.parse()?;
     let tol: f64 = args.get(1).ok_or(usage)?.parse()?;
     let projected = args.get(2).ok_or(usage)? == "project";
     let stiff_jacobian = args.get(3).ok_or(usage)? == "stiff";
-    let text = std::fs::read_to_string("examples/seed.toml")?
-        .replace("base_modes = 6", &format!("base_modes = {modes}"));
+    let text = std::fs::read_to_string("examples/seed.toml")?.replace(
+        "synchronisation = \"cable\"\n",
+        &format!("synchronisation = \"cable\"\nbase_modes = {modes}\n"),
+    );
     let sc = Scenario::from_toml_str(&text, "seed.toml")?;
     let d: Deployment = sc.deployment.clone().ok_or("no deployment")?;
     let c = d.coupled(&sc.structure)?;
