@@ -373,11 +373,17 @@ fn run_deploy(c: &Common) -> Result<(), ExitCode> {
     let scenario = load(c, RunParts::DEPLOY)?;
     let d = need_deployment(path, &scenario)?;
     let staged = prepare(out, c.force)?;
+    let progress = Progress::new(false);
+    let started = std::time::Instant::now();
     let (coupled, result) =
-        flexcraft::deploy::simulate_coupled(&scenario.structure, d).map_err(|e| {
+        flexcraft::deploy::simulate_coupled_observed(&scenario.structure, d, true, &mut |p| {
+            deploy_progress(&progress, started, p)
+        })
+        .map_err(|e| {
             eprintln!("error: {}: {e}", path.display());
             ExitCode::from(FAILED)
         })?;
+    progress.done();
     not_finite(path, flexcraft::finite::check_deployment(&result))?;
     finish(
         json,
@@ -431,6 +437,37 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     Ok(())
 }
 
+/// The automatic deployment's progress on stderr: its cost before each refinement run that
+/// is expected to take more than two seconds (from the evaluations so far and the time they
+/// took), and the time reached on the progress bar.
+fn deploy_progress(
+    progress: &Progress,
+    started: std::time::Instant,
+    p: flexcraft::deploy::auto::Progress,
+) {
+    use flexcraft::deploy::auto::{Progress as P, LEVELS};
+    match p {
+        P::Starting {
+            run,
+            expected: Some(expected),
+            done,
+        } => {
+            let rate = done as f64 / started.elapsed().as_secs_f64().max(1e-6);
+            let seconds = expected as f64 / rate;
+            if seconds > 2.0 {
+                eprintln!(
+                    "deployment: refining the model and the steps (run {run} of at most \
+                     {LEVELS}): about {expected} evaluations, {seconds:.0} s"
+                );
+            }
+        }
+        P::At { run, t, end } => progress.message(format!(
+            "deployment run {run} of at most {LEVELS}: t = {t:.1} of {end} s"
+        )),
+        _ => {}
+    }
+}
+
 /// A progress bar on stderr, drawn only on a terminal, only once the run has taken more than
 /// a second, and never with --quiet.
 struct Progress {
@@ -469,6 +506,12 @@ impl Progress {
     fn stage(&self, k: u64, msg: &'static str) {
         if let Some(b) = &self.bar {
             b.set_position(k);
+            b.set_message(msg);
+        }
+    }
+
+    fn message(&self, msg: String) {
+        if let Some(b) = &self.bar {
             b.set_message(msg);
         }
     }

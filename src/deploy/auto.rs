@@ -110,6 +110,33 @@ fn base_at(d: &Deployment, margin: f64, at_least: usize) -> (BaseKind, Option<f6
     }
 }
 
+/// What the automatic run tells an observer while it works (the command line's progress and
+/// cost estimate; the library never prints).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum Progress {
+    /// Run `run` (1-based) of at most [`LEVELS`] starts; from the second on, the right-hand-
+    /// side evaluations it is expected to take (the previous run's times 2.5: twice the
+    /// steps where the kept modes set them, and more modes) and those made so far.
+    Starting {
+        /// The run's number, from 1.
+        run: usize,
+        /// The expected evaluations of this run (None for the first).
+        expected: Option<usize>,
+        /// Evaluations made by the runs before it.
+        done: usize,
+    },
+    /// Run `run` has reached time `t` (s) of at most `end` (s).
+    At {
+        /// The run's number, from 1.
+        run: usize,
+        /// Time reached, s.
+        t: f64,
+        /// The deployment's end time, s.
+        end: f64,
+    },
+}
+
 /// One run at level `k`.
 fn run_level(
     st: &Structure,
@@ -117,6 +144,7 @@ fn run_level(
     k: usize,
     at_least: usize,
     record_samples: bool,
+    observe: &mut dyn FnMut(Progress),
 ) -> Result<(Coupled, DeploymentResult, Option<f64>, Schedule), DeployError> {
     let (margin, schedule) = level(k);
     let (base, cutoff) = base_at(d, margin, at_least);
@@ -127,7 +155,10 @@ fn run_level(
         schedule,
         ..dk.settings()
     };
-    let r = super::run::run(&c, &settings, super::MAX_STEPS);
+    let end = settings.end_time;
+    let r = super::run::run_observed(&c, &settings, super::MAX_STEPS, &mut |t| {
+        observe(Progress::At { run: k + 1, t, end })
+    });
     Ok((c, r, cutoff, schedule))
 }
 
@@ -230,7 +261,22 @@ pub fn simulate(
     d: &Deployment,
     record_samples: bool,
 ) -> Result<(Coupled, DeploymentResult, Accuracy), DeployError> {
-    let (mut c, mut r, _, _) = run_level(st, d, 0, 0, record_samples)?;
+    simulate_observed(st, d, record_samples, &mut |_| {})
+}
+
+/// [`simulate`], telling `observe` where it is ([`Progress`]).
+pub fn simulate_observed(
+    st: &Structure,
+    d: &Deployment,
+    record_samples: bool,
+    observe: &mut dyn FnMut(Progress),
+) -> Result<(Coupled, DeploymentResult, Accuracy), DeployError> {
+    observe(Progress::Starting {
+        run: 1,
+        expected: None,
+        done: 0,
+    });
+    let (mut c, mut r, _, _) = run_level(st, d, 0, 0, record_samples, observe)?;
     let mut evaluations = r.evaluations;
     let mut k = 1;
     loop {
@@ -238,7 +284,12 @@ pub fn simulate(
         // modes): a doubled cutoff below the next mode would compare a model with itself and
         // see nothing of its truncation.
         let kept = c.modes() - c.base.correction;
-        let (c1, r1, cutoff, schedule) = run_level(st, d, k, kept + 2, record_samples)?;
+        observe(Progress::Starting {
+            run: k + 1,
+            expected: Some(r.evaluations * 5 / 2),
+            done: evaluations,
+        });
+        let (c1, r1, cutoff, schedule) = run_level(st, d, k, kept + 2, record_samples, observe)?;
         evaluations += r1.evaluations;
         let (times, rates, latch_moments, root_loads, events_differ) =
             compare(d, &r, &r1, c1.base.beams.len());

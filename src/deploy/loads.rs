@@ -412,6 +412,12 @@ impl Engine for Coupled {
             },
         )
     }
+    fn energy(&self, y: &[f64], captured: &[bool]) -> f64 {
+        Coupled::kinetic_energy(self, y)
+            + self.spring_energy(y)
+            + self.elastic_energy(y)
+            + self.latch_energy(y, captured)
+    }
     fn kinetic_energy(&self, y: &[f64]) -> f64 {
         Coupled::kinetic_energy(self, y)
     }

@@ -456,8 +456,19 @@ pub fn simulate_coupled_with(
     d: &Deployment,
     record_samples: bool,
 ) -> Result<(Coupled, DeploymentResult), DeployError> {
+    simulate_coupled_observed(st, d, record_samples, &mut |_| {})
+}
+
+/// [`simulate_coupled_with`], telling `observe` how the automatic integrator's runs progress
+/// ([`auto::Progress`]; a named integrator reports nothing).
+pub fn simulate_coupled_observed(
+    st: &Structure,
+    d: &Deployment,
+    record_samples: bool,
+    observe: &mut dyn FnMut(auto::Progress),
+) -> Result<(Coupled, DeploymentResult), DeployError> {
     let (c, mut r) = if d.integrator == Integrator::Auto {
-        let (c, mut r, acc) = auto::simulate(st, d, record_samples)?;
+        let (c, mut r, acc) = auto::simulate_observed(st, d, record_samples, observe)?;
         if !acc.reached() {
             r.warnings.push(Warning::AccuracyNotReached(acc.clone()));
         }

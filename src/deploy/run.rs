@@ -84,6 +84,11 @@ pub(crate) trait Engine {
     fn impact(&self, y: &[f64], free_after: &[bool]) -> (Vec<f64>, Impulses);
     /// Kinetic energy, J.
     fn kinetic_energy(&self, y: &[f64]) -> f64;
+    /// The mechanical energy (kinetic, hinge and cable springs, the base's elastic energy and
+    /// the captured latches' springs), J: conserved but for dampers, friction and impacts.
+    fn energy(&self, y: &[f64], _captured: &[bool]) -> f64 {
+        self.kinetic_energy(y)
+    }
     /// The sample at time t.
     fn sample(&self, t: f64, y: &[f64], free: &[bool], captured: &[bool]) -> Sample;
     /// ∂(dy/dt)/∂y, or its stiff part, into `jac` (zeroed); false when the model has none
@@ -207,6 +212,10 @@ impl Engine for PlanarEngine<'_> {
         let n = self.0.dof();
         self.0.kinetic_energy(&y[..n], &y[n..])
     }
+    fn energy(&self, y: &[f64], _captured: &[bool]) -> f64 {
+        let n = self.0.dof();
+        self.0.kinetic_energy(&y[..n], &y[n..]) + self.0.spring_energy(&y[..n])
+    }
     fn sample(&self, t: f64, y: &[f64], free: &[bool], _captured: &[bool]) -> Sample {
         let chain = self.0;
         let (n, h) = (chain.dof(), chain.hub_dof());
@@ -272,6 +281,10 @@ struct Scheduled {
     omega: f64,
     /// The longest step at all, s.
     longest: f64,
+    /// The hinges with Coulomb friction.
+    rubbing: Vec<bool>,
+    /// The largest mechanical energy seen, J (the scale of [`ENERGY_GROWTH`]).
+    energy_scale: f64,
 }
 
 impl Scheduled {
@@ -281,9 +294,8 @@ impl Scheduled {
         t: &mut f64,
         y: &mut [f64],
         t_end: f64,
-        open_rates: std::ops::Range<usize>,
-        open: &[bool],
-        rubbing: &[bool],
+        (open_rates, open): (std::ops::Range<usize>, &[bool]),
+        energy: &dyn Fn(&[f64]) -> f64,
     ) -> DenseStep {
         self.restorer.start(sys, y);
         let f = self.rodas.derivative(sys, *t, y);
@@ -299,16 +311,20 @@ impl Scheduled {
                 // Coulomb friction is regularised linearly below FRICTION_RATE: a stiff
                 // damping there, which a long step linearises across the whole step and
                 // holds the hinge back (a panel released from rest latched 0.53 s late). A
-                // hinge with friction changes its rate by at most half of it per step (or
-                // of 10 FRICTION_RATE), so that it leaves the band within a few short steps
-                // and stays in it only where it truly sticks (where α̈ ≈ 0).
-                if rubbing.get(j).copied().unwrap_or(false) {
+                // hinge with friction leaving the band (its rate below 100 FRICTION_RATE and
+                // growing) changes its rate by at most half of it per step, or of
+                // 10 FRICTION_RATE, so that it is out within a few short steps; one held in
+                // the band (sticking, its rate pulled back towards it) sets no bound.
+                if self.rubbing.get(j).copied().unwrap_or(false)
+                    && y[k].abs() < 100.0 * FRICTION_RATE
+                    && y[k] * f[k] >= 0.0
+                {
                     let scale = y[k].abs().max(10.0 * FRICTION_RATE);
                     h = h.min(0.5 * scale / f[k].abs());
                 }
             }
         }
-        let mut dense = self.rodas.step_scheduled(sys, t, y, t_end, h);
+        let mut dense = self.guarded(sys, t, y, t_end, h, energy);
         if y.iter().all(|v| v.is_finite()) {
             let correction = self.restorer.restore(sys, y, false);
             if correction.iter().any(|(_, d)| *d != 0.0) {
@@ -321,6 +337,58 @@ impl Scheduled {
         dense
     }
 }
+
+impl Scheduled {
+    /// One scheduled step that does not create energy: a step whose mechanical energy grows
+    /// by more than [`ENERGY_GROWTH`] of the largest energy seen is taken again with the
+    /// Jacobian differenced (Rodas5P keeps its L-stability on the base's stiff modes only with
+    /// the exact one; the model's analytic stiff part leaves out the configuration's slopes,
+    /// which at steps far beyond a mode's period let it grow: a six-panel wing's hub reached
+    /// 1e15 rad/s), then at half the step, down to [`GUARD_HALVINGS`] times. Nothing in the
+    /// model supplies energy (a held hub does no work), so growth is the method's.
+    fn guarded(
+        &mut self,
+        sys: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_end: f64,
+        h: f64,
+        energy: &dyn Fn(&[f64]) -> f64,
+    ) -> DenseStep {
+        let (t0, y0) = (*t, y.to_vec());
+        let e0 = energy(&y0);
+        self.energy_scale = self.energy_scale.max(e0.abs());
+        let mut h = h;
+        let mut attempt = 0;
+        loop {
+            let dense = self.rodas.step_scheduled(sys, t, y, t_end, h);
+            let e1 = energy(y);
+            // A non-finite energy grew too.
+            let grew = e1.is_nan() || e1 > e0 + ENERGY_GROWTH * self.energy_scale;
+            self.rodas.differenced = false;
+            if !grew || attempt > GUARD_HALVINGS {
+                self.energy_scale = self.energy_scale.max(e1.abs());
+                return dense;
+            }
+            // Back to the step's start, with the exact Jacobian (and, from the second retry
+            // on, half the step).
+            attempt += 1;
+            *t = t0;
+            y.copy_from_slice(&y0);
+            self.rodas.refresh_derivative(sys, t0, &y0);
+            self.rodas.differenced = true;
+            if attempt > 1 {
+                h *= 0.5;
+            }
+        }
+    }
+}
+
+/// The mechanical energy a scheduled step may gain, as a fraction of the largest seen.
+const ENERGY_GROWTH: f64 = 1e-4;
+
+/// The halvings of a scheduled step that gains energy with the exact Jacobian.
+const GUARD_HALVINGS: usize = 8;
 
 /// The stepper a run uses.
 enum Stepper {
@@ -340,6 +408,8 @@ impl Stepper {
                 rule: s.schedule,
                 omega: 0.0,
                 longest: LONGEST_STEP * s.end_time,
+                rubbing: Vec::new(),
+                energy_scale: 0.0,
             })),
             Integrator::Explicit => Self::Explicit(Dopri5::new(rtol, atol, f64::INFINITY)),
             Integrator::Implicit => Self::Implicit(Rodas5P::new(rtol, atol, f64::INFINITY)),
@@ -354,7 +424,7 @@ impl Stepper {
             Self::Implicit(s) => s.step(sys, t, y, t_end),
             Self::Adiabatic(s) => s.step(sys, t, y, t_end),
             // The run calls Scheduled::step itself (it needs the open hinges).
-            Self::Scheduled(s) => s.step(sys, t, y, t_end, 0..0, &[], &[]),
+            Self::Scheduled(s) => s.step(sys, t, y, t_end, (0..0, &[]), &|_| 0.0),
         }
     }
     /// A state taken from the dense output (an event's) with its conserved quantities
@@ -527,6 +597,15 @@ impl<'a, E: Engine> Run<'a, E> {
     /// captured hinges with the captured ones' latch springs; otherwise the open hinges alone
     /// (captured hinges then sit quasi-statically on their latches, locked ones do not move).
     fn with_phase(mut self) -> Self {
+        if let Stepper::Scheduled(s) = &mut self.solver {
+            s.rubbing = self
+                .sys
+                .engine
+                .hinges()
+                .iter()
+                .map(|h| h.friction > 0.0)
+                .collect();
+        }
         self.set_phase();
         self
     }
@@ -733,21 +812,14 @@ impl<'a, E: Engine> Run<'a, E> {
             Stepper::Scheduled(s) => {
                 let ro = self.sys.engine.positions() + self.sys.engine.rate_offset();
                 let open = self.sys.open();
-                let rubbing: Vec<bool> = self
-                    .sys
-                    .engine
-                    .hinges()
-                    .iter()
-                    .map(|h| h.friction > 0.0)
-                    .collect();
+                let (engine, captured) = (self.sys.engine, &self.sys.captured);
                 s.step(
                     &self.sys,
                     &mut self.t,
                     &mut self.y,
                     t_stop,
-                    ro..ro + open.len(),
-                    &open,
-                    &rubbing,
+                    (ro..ro + open.len(), &open),
+                    &|y| engine.energy(y, captured),
                 )
             }
             solver => solver.step(&self.sys, &mut self.t, &mut self.y, t_stop),
@@ -1120,6 +1192,16 @@ fn load_times(fastest: f64, t0: f64, t_limit: f64) -> Vec<f64> {
 /// Runs `engine` from release until every hinge has latched or the end time (at most
 /// `max_steps` steps).
 pub(crate) fn run<E: Engine>(engine: &E, s: &RunSettings, max_steps: usize) -> DeploymentResult {
+    run_observed(engine, s, max_steps, &mut |_| {})
+}
+
+/// [`run`], telling `progress` the time reached (s) every [`PROGRESS_STEPS`] steps.
+pub(crate) fn run_observed<E: Engine>(
+    engine: &E,
+    s: &RunSettings,
+    max_steps: usize,
+    progress: &mut dyn FnMut(f64),
+) -> DeploymentResult {
     let mut run = Run::new(engine, s);
     let mut steps = 0usize;
     let mut diverged = false;
@@ -1129,6 +1211,12 @@ pub(crate) fn run<E: Engine>(engine: &E, s: &RunSettings, max_steps: usize) -> D
             diverged = true;
             break;
         }
+        if steps % PROGRESS_STEPS == 0 {
+            progress(run.t);
+        }
     }
     run.finish(steps >= max_steps, diverged)
 }
+
+/// Steps between two progress reports ([`run_observed`]).
+const PROGRESS_STEPS: usize = 256;

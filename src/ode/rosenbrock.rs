@@ -235,6 +235,9 @@ pub struct Rodas5P {
     fresh: bool,
     /// Number of right-hand-side evaluations so far (Jacobians included).
     pub evaluations: usize,
+    /// Difference the Jacobian (n + 1 evaluations) even when the system offers its own (a
+    /// part of it): Rodas5P keeps its stability on stiff modes only with the exact one.
+    pub differenced: bool,
 }
 
 /// Relative perturbation of the forward-difference Jacobian (≈ √ε).
@@ -251,6 +254,7 @@ impl Rodas5P {
             f0: Vec::new(),
             fresh: true,
             evaluations: 0,
+            differenced: false,
         }
     }
 
@@ -362,7 +366,7 @@ impl Rodas5P {
         self.derivative(sys, *t, y);
         let jac = {
             let mut j = Mat::zeros(n, n);
-            if sys.jacobian(*t, y, &mut j) {
+            if !self.differenced && sys.jacobian(*t, y, &mut j) {
                 j
             } else {
                 self.jacobian(sys, *t, y)

@@ -155,7 +155,7 @@ fn model_names(d: &Deployment, c: &Coupled) -> (String, String) {
 }
 
 /// The model and method the run used, and the automatic integrator's accuracy estimate.
-fn model_json(d: &Deployment, c: &Coupled, r: &DeploymentResult) -> Value {
+pub fn model_json(d: &Deployment, c: &Coupled, r: &DeploymentResult) -> Value {
     let kept = c.modes() - c.base.correction;
     let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
     let mut v = json!({
@@ -194,41 +194,48 @@ fn accuracy_line(c: &Coupled, r: &DeploymentResult) -> Option<String> {
     let a = r.accuracy.as_ref()?;
     let hz = |w: f64| w / (2.0 * std::f64::consts::PI);
     let kept = c.modes() - c.base.correction;
-    let cutoff = a
-        .cutoff
-        .map_or(String::new(), |w| format!(" (cutoff {:.3} Hz)", hz(w)));
     let top = c.base.omega[..kept].iter().copied().fold(0.0, f64::max);
-    let model = format!(
-        "integrator auto: Rodas5P at steps set by each phase (κ = {:.3}, δ = {:.4} rad), the \
-         base's modes to {:.3} Hz{cutoff} resolved once excited, {} static-correction vectors \
-         quasi-static; {} runs, {} evaluations",
-        a.schedule.kappa,
-        a.schedule.delta,
-        hz(top),
-        c.base.correction,
-        a.runs,
-        a.evaluations
-    );
-    let scope = if a.first_impact_only {
-        "the first impact's time and rate (what follows an impact on an elastic base depends on \
-         the base modes kept)"
-    } else {
-        "capture times and rates, peak latch moments"
+    let modes = match (kept, a.cutoff) {
+        (0, _) => "no base mode kept".to_string(),
+        (k, Some(w)) => format!(
+            "the base's {k} lowest modes (to {:.4} Hz; the array's time scales set the \
+             cutoff at {:.4} Hz, each refinement keeps two more)",
+            hz(top),
+            hz(w)
+        ),
+        (k, None) => format!("the base's {k} lowest modes (to {:.4} Hz)", hz(top)),
     };
+    let resolved = if a.first_impact_only {
+        "followed quasi-statically between the array's steps"
+    } else {
+        "resolved from the first capture on"
+    };
+    let model = format!(
+        "integrator auto: Rodas5P at steps set by each phase (κ = {:.3}, δ = {:.4} rad); {modes}, \
+         {resolved}; {} static-correction vectors, quasi-static; {} runs, {} evaluations",
+        a.schedule.kappa, a.schedule.delta, c.base.correction, a.runs, a.evaluations
+    );
+    let flag = if a.reached() { "" } else { ", NOT reached" };
     let estimate = if a.events_differ {
         "the last two runs differ in their events: no estimate".to_string()
+    } else if a.first_impact_only {
+        format!(
+            "estimate {:.1e} (asked {:.0e}{flag}): time {:.1e}, rate {:.1e}; what follows the \
+             impact depends on the base modes kept (a rigid latch on an elastic base has no \
+             continuum limit) and is reported with the model above",
+            a.estimate, a.asked, a.times, a.rates
+        )
     } else {
         format!(
-            "estimate {:.1e} (asked {:.0e}{}): times {:.1e}, rates {:.1e}, latch moments {:.1e}; \
-             root loads {:.1e} (estimated, not bounded)",
-            a.estimate,
-            a.asked,
-            if a.reached() { "" } else { ", NOT reached" },
-            a.times,
-            a.rates,
-            a.latch_moments,
-            a.root_loads
+            "estimate {:.1e} (asked {:.0e}{flag}): times {:.1e}, rates {:.1e}, latch moments \
+             {:.1e}; root loads {:.1e} (estimated, not bounded)",
+            a.estimate, a.asked, a.times, a.rates, a.latch_moments, a.root_loads
         )
+    };
+    let scope = if a.first_impact_only {
+        "the first impact"
+    } else {
+        "the captures and latch loads"
     };
     Some(format!("{model}\naccuracy of {scope}: {estimate}"))
 }

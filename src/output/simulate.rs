@@ -202,6 +202,7 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             "peak_hinge_reactions": super::deploy::peak_hinge_reactions(&sim.coupled, dep),
             "captures": dep.captures.iter().map(|k| json!({"time": k.time, "hinge": k.hinge, "rates": k.rates})).collect::<Vec<_>>(),
             "peak_latch_moments": super::deploy::peak_latch_moments(dep),
+            "model": d.map_or(Value::Null, |d| super::deploy::model_json(d, &sim.coupled, dep)),
         },
         "modes": {
             "dof": sim.modes.dof,
