@@ -50,6 +50,7 @@ plate = "wing"
 panels = 3
 end_time = 60.0
 output_rate = 20.0
+integrator = "explicit"
 tolerance = 1e-10
 [deployment.hinge]
 stiffness = 2.0

@@ -278,3 +278,41 @@ fn write_bench_spacecraft() {
         std::fs::write(bench_file(seed), spacecraft(seed).toml).unwrap();
     }
 }
+
+/// The bundled examples by default against their every-mode reference — the adiabatic
+/// integrator with all 26 base modes at 1e-10, itself held to the explicit run by
+/// `tests/suite/adiabatic.rs` — within the accuracy the default run reports: the seed's latch
+/// time (rigid latch: the first impact), seed_compliant's capture time and peak latch moments.
+#[test]
+fn val_the_examples_deploy_by_default_as_their_all_mode_reference() {
+    for (file, compliant) in [("seed.toml", false), ("seed_compliant.toml", true)] {
+        let sc = super::common::edited_example(file, |s| s);
+        let d = sc.deployment.as_ref().unwrap();
+        let (_, auto) = simulate_coupled(&sc.structure, d).unwrap();
+        let a = auto.accuracy.clone().unwrap();
+        assert!(a.reached(), "{file}: {a:?}");
+        let reference = Deployment {
+            integrator: Integrator::Adiabatic,
+            tolerance: 1e-10,
+            ..d.clone()
+        };
+        let (c, r) = simulate_coupled(&sc.structure, &reference).unwrap();
+        assert_eq!(c.modes(), c.base.spectrum.len(), "every mode");
+        let bound = a.asked.max(a.estimate);
+        let (mine, theirs) = (events(&auto), events(&r));
+        assert_eq!(mine.len(), theirs.len(), "{file}");
+        for (m, t) in mine.iter().zip(&theirs) {
+            assert!((m.0 - t.0).abs() <= bound * t.0, "{file}: {m:?} vs {t:?}");
+        }
+        if compliant {
+            let n = d.chain.len();
+            for j in 0..n {
+                let (p, q) = (auto.latch_up_peaks[j].0, r.load_peaks[j].0);
+                assert!(
+                    (p - q).abs() <= bound * q,
+                    "{file}: latch moment {j}: {p} vs {q}"
+                );
+            }
+        }
+    }
+}
