@@ -70,6 +70,12 @@ pub enum Warning {
     /// The automatic integrator's accuracy estimate stayed above the accuracy asked for
     /// after its last refinement.
     AccuracyNotReached(crate::deploy::auto::Accuracy),
+    /// The automatic integrator accepted steps that gained mechanical energy even with the
+    /// exact Jacobian and the step halved eight times.
+    EnergyGained {
+        /// How many.
+        steps: usize,
+    },
     /// Compliant latches still moving when the settling's cap, or the deployment's end time,
     /// ended the deployment.
     NotSettled {
@@ -195,6 +201,13 @@ impl fmt::Display for Warning {
                 h.kept
             ),
             Self::AccuracyNotReached(a) => accuracy_not_reached(f, a),
+            Self::EnergyGained { steps } => write!(
+                f,
+                "{steps} step(s) of the automatic integrator gained mechanical energy even with \
+                 the exact Jacobian and the step halved eight times (nothing in the model \
+                 supplies energy): the results there are doubtful; compare with integrator = \
+                 \"explicit\""
+            ),
             Self::AngleMismatch { rad } => write!(
                 f,
                 "the array locked away from the straight wing (largest hinge-angle mismatch \
@@ -218,7 +231,6 @@ impl fmt::Display for Warning {
     }
 }
 
-/// [`Warning::NotSettled`]'s text.
 /// [`Warning::AccuracyNotReached`]'s text.
 fn accuracy_not_reached(
     f: &mut fmt::Formatter<'_>,
@@ -244,6 +256,7 @@ fn accuracy_not_reached(
     }
 }
 
+/// [`Warning::NotSettled`]'s text.
 fn not_settled(t: f64, ratio: Option<f64>, tolerance: f64, by_end_time: bool) -> String {
     let left = ratio.map_or(String::new(), |r| {
         format!(

@@ -3,19 +3,22 @@
 //!
 //! The model: the base keeps its hub-fixed modes up to a cutoff ω_c = μ ω_a, ω_a the
 //! array's fastest motion ([`super::timescales::fastest`]: its hinge springs and cable, base
-//! held), plus the static correction of the modes above ([`super::static_correction`]). The method: Rodas5P at steps set by the phase
-//! ([`super::Schedule`]): κ/ω of the array's fastest motion in the phase, and at most a
-//! turn δ of any opening hinge; the base's vibration above 1/h follows its quasi-static
-//! solution.
+//! held), plus the static correction of the modes above ([`super::static_correction`]). The
+//! method: Rodas5P at steps set by the phase ([`super::Schedule`]): κ/ω of the fastest motion
+//! the phase must resolve, and at most a turn δ of any opening hinge; the base's vibration
+//! above 1/h follows its quasi-static solution.
 //!
-//! The accuracy: the run is repeated with everything refined twofold (μ doubled, κ and δ
-//! halved) and the two compared on what is well posed — every capture's time and rates and,
-//! with compliant latches, the peaks of the latch moments and of the base beams' root loads
-//! from the first capture on; with rigid latches the first impact's time and rates (after an
-//! impact on an elastic base the outcome depends on the modes kept: no continuum limit). The
-//! finer run is reported, with the largest relative difference as its error estimate, and
-//! the refinement goes on while the estimate exceeds the accuracy asked for (at most
-//! [`LEVELS`] runs; then the run says which estimate it reached).
+//! The accuracy: the run is repeated with everything refined (μ doubled with at least two
+//! more modes, κ divided by √2, δ halved) and the two compared on what is well posed: every
+//! capture's time and the capturing hinge's rate and, with compliant latches, the peak latch
+//! moments from the first capture on (the base beams' root loads are estimated beside them);
+//! with rigid latches the first impact's time and rate (after an impact on an elastic base the
+//! outcome depends on the modes kept: no continuum limit); with no latch or capture before the
+//! end time, the angles and rates reached there. The finer run is reported, with the largest
+//! relative difference as its error estimate, and the refinement goes on while the estimate
+//! exceeds the accuracy asked for (at most [`LEVELS`] runs; then the run says which estimate
+//! it reached). With `base_modes` given, the count stays the user's and only the steps are
+//! refined.
 
 use super::base::BaseKind;
 use super::coupled::Coupled;
@@ -51,7 +54,9 @@ pub struct Accuracy {
     /// The estimate: the largest relative difference between the reported run and the one
     /// before it in the events' times and rates and the peak latch moments.
     pub estimate: f64,
-    /// Its parts: capture (or first impact) times, relative to the time since release.
+    /// Its parts: capture (or first impact) times, relative to the time since release (with
+    /// no latch or capture before the end time: the angles reached there, against the latch
+    /// angles).
     pub times: f64,
     /// The latching (captured) hinge's rate at each of those events, relative to the largest
     /// such rate (a hinge creeping into its latch has a small rate, of no design consequence,
@@ -200,6 +205,28 @@ fn compare(
     let (a, b) = (events(coarse), events(fine));
     if a.len() != b.len() || a.iter().zip(&b).any(|(x, y)| x.1 != y.1) {
         return (f64::INFINITY, f64::INFINITY, 0.0, 0.0, true);
+    }
+    if b.is_empty() {
+        // No latch and no capture before the end time: the state reached instead, every
+        // hinge's angle against its latch angle and its rate against the largest rate.
+        let (Some(x), Some(y)) = (coarse.samples.last(), fine.samples.last()) else {
+            return (f64::INFINITY, f64::INFINITY, 0.0, 0.0, true);
+        };
+        let angles = x
+            .alpha
+            .iter()
+            .zip(&y.alpha)
+            .zip(&d.chain.hinges)
+            .map(|((p, q), h)| rel(*p, *q, h.latch_angle.abs()))
+            .fold(0.0, f64::max);
+        let largest = y.rate.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let rates = x
+            .rate
+            .iter()
+            .zip(&y.rate)
+            .map(|(p, q)| rel(*p, *q, largest))
+            .fold(0.0, f64::max);
+        return (angles, rates, 0.0, 0.0, false);
     }
     // Each event's time, against the time since release, and the latching (or captured)
     // hinge's rate there, against itself: the other hinges' rates at that instant include

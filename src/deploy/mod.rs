@@ -435,7 +435,13 @@ pub fn simulate(d: &Deployment) -> DeploymentResult {
 /// [`simulate`] with a step limit of the caller's choosing: the run stops after `max_steps`
 /// steps with [`RunStatus::StepLimit`] (and its warning).
 pub fn simulate_limited(d: &Deployment, max_steps: usize) -> DeploymentResult {
-    run::run(&run::PlanarEngine(&d.chain), &d.settings(), max_steps)
+    // The rigid reference is integrated explicitly at the deployment's tolerance whatever the
+    // integrator asked for the coupled run (the automatic one chooses for an elastic base).
+    let mut s = d.settings();
+    if s.integrator == Integrator::Auto {
+        s.integrator = Integrator::Explicit;
+    }
+    run::run(&run::PlanarEngine(&d.chain), &s, max_steps)
 }
 
 /// The deployment of `d` on the structure `st` as one system ([`coupled`]): the array on the
@@ -494,7 +500,7 @@ pub fn simulate_coupled_observed(
                 0,
                 Warning::BaseModesClamped {
                     requested,
-                    kept: c.modes(),
+                    kept: c.modes() - c.base.correction,
                     available,
                 },
             );

@@ -231,6 +231,7 @@ mod tests {
             &[false, true],
         );
         assert!((alone[0] - (k2 / (m * l * l / 3.0)).sqrt()).abs() < 1e-12 * alone[0]);
+        assert_eq!(got.len(), 2, "{got:?}");
         for (g, w) in got.iter().zip(want) {
             // The midpoint rule's error on the bars' l²/12 terms: 1/(4 points²) relative.
             assert!((g - w).abs() < 1e-5 * w, "{got:?} vs {want:?}");

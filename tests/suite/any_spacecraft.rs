@@ -60,7 +60,16 @@ fn check(seed: u64) -> Result<(), TestCaseError> {
             r.warnings
         );
     }
-    prop_assert!(r.accuracy.is_some(), "seed {seed}");
+    // An estimate above the accuracy asked for is said in the warnings.
+    let a = r.accuracy.clone().unwrap();
+    prop_assert_eq!(
+        a.reached(),
+        !r.warnings
+            .iter()
+            .any(|w| w.to_string().starts_with("accuracy not reached")),
+        "seed {}",
+        seed
+    );
     if drawn.free_hub {
         let (p_scale, l_scale) = momentum_scale(&sc, &r);
         let (p0, l0, _) = c.momentum(&c.initial_state());
@@ -112,16 +121,30 @@ const SAMPLE_MOMENTUM: f64 = 1e-3;
 
 proptest! {
     #![proptest_config(ProptestConfig {
-        cases: 16,
+        cases: 32,
         failure_persistence: Some(Box::new(
             proptest::test_runner::FileFailurePersistence::SourceParallel("proptest-regressions")
         )),
+        // Seeded: the same 32 spacecraft on every run, so that CI is repeatable; the
+        // sweep below reaches others.
+        rng_seed: proptest::test_runner::RngSeed::Fixed(36),
         ..ProptestConfig::default()
     })]
     /// A few random spacecraft on every run of the suite.
     #[test]
     fn prop_any_spacecraft_deploys_by_default(seed in any::<u64>()) {
         check(seed)?;
+    }
+}
+
+/// Seeds the proptest has found failing on earlier runs (kept also in
+/// `proptest-regressions/suite/any_spacecraft.txt`): a six-panel wing whose hub reached
+/// 1e15 rad/s before the energy guard (…364), momentum off by 4e-9 of its scale at the end
+/// before the final state was restored (…366).
+#[test]
+fn found_spacecraft_deploy_by_default() {
+    for seed in [11357577217028387364, 11357577217028387366] {
+        check(seed).unwrap();
     }
 }
 
@@ -181,7 +204,10 @@ fn agrees_with_the_reference(seed: u64) {
         theirs.iter().map(|e| e.1).collect::<Vec<_>>(),
         "seed {seed}: event order"
     );
-    let bound = a.asked.max(a.estimate);
+    assert!(!theirs.is_empty(), "seed {seed}: nothing latched");
+    // The accuracy asked for where the run says it reached it, its estimate otherwise.
+    assert!(!a.events_differ, "seed {seed}: {a:?}");
+    let bound = if a.reached() { a.asked } else { a.estimate };
     for (m, t) in mine.iter().zip(&theirs) {
         let rel = (m.0 - t.0).abs() / t.0;
         assert!(
@@ -195,8 +221,8 @@ fn agrees_with_the_reference(seed: u64) {
 }
 
 /// A cheap subset on every run: among seeds 0…22 the two whose all-mode explicit reference
-/// takes seconds (a six-panel compliant wing latching within 1.1 s, a two-panel one over
-/// 116 s).
+/// takes seconds (a five-panel rigid-latch wing whose first impact comes at 0.39 s, a
+/// two-panel compliant one capturing over 116 s).
 #[test]
 fn val_random_spacecraft_latch_like_the_all_mode_explicit_reference() {
     for seed in [4, 22] {
