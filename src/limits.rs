@@ -248,14 +248,21 @@ pub fn valid_name(name: &str) -> Result<(), String> {
 /// The rule for the scenario's title: free text of at most [`MAX_TITLE`] characters without
 /// control characters.
 pub fn valid_title(title: &str) -> Result<(), String> {
-    let n = title.chars().count();
+    valid_text("the title", title)
+}
+
+/// The title's rule for any free text a scenario gives that reaches a terminal or a report
+/// (`what`: "the title", "a requirement's name"): at most [`MAX_TITLE`] characters, no
+/// control characters (an escape sequence would reach stdout raw).
+pub fn valid_text(what: &str, text: &str) -> Result<(), String> {
+    let n = text.chars().count();
     if n > MAX_TITLE {
         return Err(format!(
-            "the title has at most {MAX_TITLE} characters, got {n}"
+            "{what} has at most {MAX_TITLE} characters, got {n}"
         ));
     }
-    if title.chars().any(char::is_control) {
-        return Err("the title must not contain control characters".into());
+    if text.chars().any(char::is_control) {
+        return Err(format!("{what} must not contain control characters"));
     }
     Ok(())
 }

@@ -206,17 +206,24 @@ fn numerical_failure(
 
 /// Checks, locks and stages the output directory before the computation: a target that must
 /// not be replaced is refused (exit status 2) before any work is done.
-fn prepare(out: Option<&Path>, force: bool) -> Result<Option<OutputDir>, ExitCode> {
+fn prepare(
+    out: Option<&Path>,
+    force: bool,
+    inputs: &[&Path],
+) -> Result<Option<OutputDir>, ExitCode> {
     let Some(dir) = out else { return Ok(None) };
-    OutputDir::create(dir, force).map(Some).map_err(|e| {
-        if e.is_refusal() {
-            eprintln!("error: {e}");
-            ExitCode::from(REFUSED)
-        } else {
-            eprintln!("error: writing {}: {e}", dir.display());
-            ExitCode::from(FAILED)
-        }
-    })
+    output::refuse_inputs_inside(dir, inputs)
+        .and_then(|()| OutputDir::create(dir, force))
+        .map(Some)
+        .map_err(|e| {
+            if e.is_refusal() {
+                eprintln!("error: {e}");
+                ExitCode::from(REFUSED)
+            } else {
+                eprintln!("error: writing {}: {e}", dir.display());
+                ExitCode::from(FAILED)
+            }
+        })
 }
 
 /// Prints the JSON object or the table, then writes the prepared output directory with
@@ -275,7 +282,7 @@ fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
         RunParts::MODES
     };
     let scenario = load(c, parts)?;
-    let staged = prepare(out, c.force)?;
+    let staged = prepare(out, c.force, &[c.scenario.as_path()])?;
     let model = RitzModel::assemble(&scenario.structure);
     // With an automatic term selection only the modes it aimed at are solved for (the higher
     // ones of such a model are not converged to anything).
@@ -322,7 +329,7 @@ fn run_export(c: &Common) -> Result<(), ExitCode> {
     use flexcraft::export::ExportModel;
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let scenario = load(c, RunParts::MODES)?;
-    let staged = prepare(out, c.force)?;
+    let staged = prepare(out, c.force, &[c.scenario.as_path()])?;
     let model = RitzModel::assemble(&scenario.structure);
     let wanted = scenario.export_modes();
     let selection = scenario.term_selection.as_ref();
@@ -372,7 +379,7 @@ fn run_deploy(c: &Common) -> Result<(), ExitCode> {
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let scenario = load(c, RunParts::DEPLOY)?;
     let d = need_deployment(path, &scenario)?;
-    let staged = prepare(out, c.force)?;
+    let staged = prepare(out, c.force, &[c.scenario.as_path()])?;
     let progress = Progress::new(false);
     let started = std::time::Instant::now();
     let (coupled, result) =
@@ -403,7 +410,7 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     need_deployment(path, &scenario)?;
     // The report's footer carries the SHA-256 of the text that was parsed (read once).
     let source = scenario.source_text().as_bytes().to_vec();
-    let staged = prepare(out, c.force)?;
+    let staged = prepare(out, c.force, &[c.scenario.as_path()])?;
     progress.stage(1, "modes, deployment, hand-over, response");
     let sim = Simulation::run(&scenario).map_err(|e| match &e {
         flexcraft::simulation::SimulationError::Ritz(r) => {

@@ -27,7 +27,7 @@ pub struct Args {
     /// Number of runs (overrides [montecarlo] runs).
     #[arg(long, value_name = "N")]
     runs: Option<u64>,
-    /// Threads (default: every core).
+    /// Threads (default: every core; at most 4 × the cores).
     #[arg(long, value_name = "J")]
     jobs: Option<usize>,
     /// Run only shard I of N (0-based; runs i ≡ I mod N), or `auto`: from Slurm's
@@ -86,6 +86,11 @@ fn check_shard(i: u64, n: u64, what: &str) -> Result<(u64, u64), String> {
             "{what}: shard index {i} is out of range 0…{} (shards count from 0)",
             n.max(1) - 1
         ))
+    } else if n > flexcraft::scenario::MAX_RUNS {
+        Err(format!(
+            "{what}: at most {} shards (the cap on runs)",
+            flexcraft::scenario::MAX_RUNS
+        ))
     } else {
         Ok((i, n))
     }
@@ -132,8 +137,11 @@ fn load(path: &Path, runs: Option<u64>) -> Result<(Scenario, MonteCarlo), ExitCo
     };
     s.check_dispersions().map_err(refuse)?;
     if let Some(n) = runs {
-        if n == 0 {
-            return Err(refuse("--runs 0: at least one run"));
+        if !(1..=flexcraft::scenario::MAX_RUNS).contains(&n) {
+            return Err(refuse(format!(
+                "--runs {n}: must be from 1 to {} (the scenario's cap)",
+                flexcraft::scenario::MAX_RUNS
+            )));
         }
         mc.runs = n;
     }
@@ -154,6 +162,10 @@ fn bar(total: u64, quiet: bool) -> indicatif::ProgressBar {
     }
     b
 }
+
+/// The most threads `--jobs` may ask for, per core this process may use: the runs are CPU
+/// bound, more threads only cost memory (each holds a run's model).
+const JOBS_PER_CORE: usize = 4;
 
 pub fn run(a: &Args) -> Result<(), ExitCode> {
     if let Some(Sub::Merge { dirs, out, force }) = &a.merge {
@@ -177,14 +189,18 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
         Some("auto") => auto_shard(a.shards).map_err(refuse)?,
         Some(x) => parse_shard(x).map_err(refuse)?,
     };
-    let staged = prepare(Some(out), a.force)?.expect("an output folder");
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(j) = a.jobs {
-        if j == 0 {
-            return Err(refuse("--jobs 0: at least one thread"));
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
+        if !(1..=JOBS_PER_CORE * cores).contains(&j) {
+            return Err(refuse(format!(
+                "--jobs {j}: from 1 to {} ({JOBS_PER_CORE} × the {cores} cores this process may use)",
+                JOBS_PER_CORE * cores
+            )));
         }
         pool = pool.num_threads(j);
     }
+    let staged = prepare(Some(out), a.force, &[path])?.expect("an output folder");
     let pool = pool.build().map_err(|e| {
         eprintln!("error: starting the threads: {e}");
         ExitCode::from(FAILED)
@@ -252,7 +268,8 @@ fn write(
 /// `merge DIR… --out DIR`.
 fn merge(dirs: &[PathBuf], out: &Path, force: bool) -> Result<(), ExitCode> {
     let m = output::merge_shards(dirs).map_err(refuse)?;
-    let staged = prepare(Some(out), force)?.expect("an output folder");
+    let inputs: Vec<&Path> = dirs.iter().map(PathBuf::as_path).collect();
+    let staged = prepare(Some(out), force, &inputs)?.expect("an output folder");
     write(
         staged, out, &m.text, &m.info, &m.mc, &m.names, &m.records, &m.margins,
     )
@@ -283,7 +300,7 @@ fn one_run(
             e.key, e.reason
         ))
     })?;
-    let mut staged = prepare(Some(out), force)?.expect("an output folder");
+    let mut staged = prepare(Some(out), force, &[path])?.expect("an output folder");
     let sim = flexcraft::simulation::Simulation::run(&run).map_err(|e| {
         eprintln!("error: {file}: {e}");
         ExitCode::from(FAILED)

@@ -32,6 +32,7 @@ mod suite {
     pub mod output_dir;
     pub mod plates;
     pub mod plots;
+    pub mod reliability;
     pub mod report;
     pub mod response;
     pub mod response_loads;

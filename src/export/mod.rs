@@ -479,7 +479,8 @@ impl ExportModel {
 
     /// The response's frequencies \[Hz\]: `points` log-spaced over the range (default: a
     /// decade below the lowest elastic mode to 1.5 times the highest kept), with every kept
-    /// resonance f_j and its half-power points f_j (1 ± ζ_j) added, sorted.
+    /// resonance f_j and its half-power points f_j (1 ± ζ_j) added (damped modes only),
+    /// sorted.
     pub fn frequency_grid(&self, range_hz: Option<(f64, f64)>, points: usize) -> Vec<f64> {
         let two_pi = 2.0 * std::f64::consts::PI;
         let elastic: Vec<&ExportMode> = self.modes.iter().filter(|m| !m.rigid).collect();
@@ -491,7 +492,9 @@ impl ExportModel {
         let mut f: Vec<f64> = (0..n)
             .map(|k| lo * (hi / lo).powf(k as f64 / (n - 1) as f64))
             .collect();
-        for m in &elastic {
+        // An undamped mode's resonance is infinite: its point is not added (a log-spaced
+        // point that meets it is left out by the writers).
+        for m in elastic.iter().filter(|m| m.damping_ratio > 0.0) {
             let fj = m.omega_rad_s / two_pi;
             for x in [
                 fj * (1.0 - m.damping_ratio),

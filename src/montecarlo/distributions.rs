@@ -84,7 +84,7 @@ pub enum DistributionError {
         mass: f64,
     },
     /// An empty choice, or weights that do not match.
-    #[error("a choice needs at least one value and, if weights are given, one positive weight per value")]
+    #[error("a choice needs at least one value and, if weights are given, one positive weight per value (with a finite sum)")]
     Choice,
 }
 
@@ -249,6 +249,7 @@ impl Distribution {
                 if values.is_empty()
                     || weights.len() != values.len()
                     || weights.iter().any(|w| *w <= 0.0)
+                    || !weights.iter().sum::<f64>().is_finite()
                 {
                     return Err(DistributionError::Choice);
                 }

@@ -33,8 +33,10 @@ pub fn binomial_cdf(f: u64, n: u64, q: f64) -> f64 {
         .min(1.0)
 }
 
-/// The failures allowed among n runs for probability p at confidence c: the largest f with
-/// (W.1), or `None` when n is too small even for f = 0.
+/// The failures allowed among n runs for probability p at confidence c: the largest f < n
+/// with (W.1), or `None` when n is too small even for f = 0. At least one run must succeed:
+/// with c so small that 1 − c rounds to 1, (W.1) holds for every f, and n failures would
+/// leave no run to read the tolerance bound from.
 pub fn allowed_failures(n: u64, p: f64, c: f64) -> Option<u64> {
     let q = 1.0 - p;
     let ok = |f: u64| binomial_cdf(f, n, q) <= 1.0 - c;
@@ -42,7 +44,7 @@ pub fn allowed_failures(n: u64, p: f64, c: f64) -> Option<u64> {
         return None;
     }
     // P(F ≤ f) grows with f: find the last f that satisfies (W.1) by bisection.
-    let (mut lo, mut hi) = (0, n);
+    let (mut lo, mut hi) = (0, n - 1);
     while lo < hi {
         let mid = (lo + hi).div_ceil(2);
         if ok(mid) {
@@ -64,7 +66,11 @@ pub fn runs_needed(failures: u64, p: f64, c: f64) -> u64 {
     let (mut lo, mut hi) = (failures, failures + 1);
     while !ok(hi) {
         lo = hi;
-        hi *= 2;
+        // (W.1) holds for n large enough whenever p < 1; saturate rather than overflow.
+        if hi == u64::MAX {
+            return u64::MAX;
+        }
+        hi = hi.saturating_mul(2);
     }
     while lo + 1 < hi {
         let mid = lo + (hi - lo) / 2;
@@ -97,5 +103,16 @@ mod tests {
             assert!(runs_needed(f + 1, 0.95, 0.95) > n);
         }
         assert_eq!(allowed_failures(58, 0.95, 0.95), None);
+    }
+
+    /// A confidence so small that 1 − c rounds to 1 (issue 37: an index out of bounds):
+    /// every f satisfies (W.1), and the allowed failures stop at n − 1, one run left.
+    #[test]
+    fn a_vanishing_confidence_leaves_one_run() {
+        for c in [1e-17, 1e-300, 5e-324] {
+            assert_eq!(allowed_failures(10, 0.95, c), Some(9));
+            assert_eq!(allowed_failures(1, 0.5, c), Some(0));
+            assert_eq!(runs_needed(3, 0.95, c), 4);
+        }
     }
 }

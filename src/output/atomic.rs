@@ -113,6 +113,29 @@ fn forbidden(dir: &Path, reason: &str) -> OutputError {
     }
 }
 
+/// Refuses an output folder that is, or holds, one of the command's inputs (the scenario, a
+/// shard folder being merged): replacing it would delete what the run reads, `--force` or
+/// not. Paths that do not exist yet cannot hold anything.
+pub fn refuse_inputs_inside(target: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
+    let Ok(real) = std::fs::canonicalize(target) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if let Ok(i) = std::fs::canonicalize(input) {
+            if i.starts_with(&real) {
+                return Err(forbidden(
+                    target,
+                    &format!(
+                        "holds the input {} (it would be replaced; choose another folder)",
+                        input.display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn io_at(path: &Path, what: &str, e: std::io::Error) -> OutputError {
     OutputError::Io(std::io::Error::new(
         e.kind(),

@@ -449,10 +449,24 @@ const UNITS: &str = "SI: Hz, rad/s, kg, m, rad, N, N m; mode shapes mass-normali
 rad/sqrt(kg)); structure (hub) frame, hub inputs/outputs at its reference point; docs/export.md";
 
 /// frequency_response.csv: per transfer, the real and imaginary parts, magnitude and phase.
-fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io::Result<Vec<u8>> {
+/// With `left_out` > 0 the first column's header says that the grid's points where a
+/// response is infinite (an undamped resonance) were left out.
+fn frequency_csv(
+    ex: &ExportModel,
+    transfers: &[Transfer],
+    f: &[f64],
+    left_out: usize,
+) -> std::io::Result<Vec<u8>> {
     let h: Vec<Vec<faer::c64>> = transfers.iter().map(|t| response_of(ex, t, f)).collect();
     csv_bytes(|w| {
-        let mut header = vec!["frequency [Hz]".to_string(), "omega [rad/s]".to_string()];
+        let first = if left_out > 0 {
+            format!(
+                "frequency [Hz] ({left_out} points at undamped resonances left out: the response is not finite there)"
+            )
+        } else {
+            "frequency [Hz]".to_string()
+        };
+        let mut header = vec![first, "omega [rad/s]".to_string()];
         for t in transfers {
             let unit = transfer_unit(&t.input, &t.output);
             let tag = format!("{}->{}", t.input, t.output);
@@ -478,6 +492,30 @@ fn frequency_csv(ex: &ExportModel, transfers: &[Transfer], f: &[f64]) -> std::io
     })
 }
 
+/// The export's frequency grid without the points where a transfer's response is not finite
+/// (at an undamped mode's resonance, ζ = 0 or so small that 1/(2ζ) overflows), and how many
+/// were left out.
+fn finite_grid(
+    ex: &ExportModel,
+    transfers: &[Transfer],
+    range_hz: Option<(f64, f64)>,
+    points: usize,
+) -> (Vec<f64>, usize) {
+    let all = ex.frequency_grid(range_hz, points);
+    let h: Vec<Vec<faer::c64>> = transfers.iter().map(|t| response_of(ex, t, &all)).collect();
+    let kept: Vec<f64> = all
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| {
+            h.iter()
+                .all(|ht| ht[*k].re.is_finite() && ht[*k].im.is_finite())
+        })
+        .map(|(_, f)| *f)
+        .collect();
+    let left_out = all.len() - kept.len();
+    (kept, left_out)
+}
+
 /// The Bode curves of `transfers` over the export's frequency grid.
 pub(crate) fn bode_curves(
     ex: &ExportModel,
@@ -485,7 +523,7 @@ pub(crate) fn bode_curves(
     range_hz: Option<(f64, f64)>,
     points: usize,
 ) -> Vec<super::plot::BodeCurve> {
-    let f = ex.frequency_grid(range_hz, points);
+    let (f, _) = finite_grid(ex, transfers, range_hz, points);
     transfers
         .iter()
         .map(|t| {
@@ -525,8 +563,11 @@ pub fn write_export(
         "model.mat",
         super::mat_bytes(&arrays, "flexcraft export, SI units").map_err(bad)?,
     )?;
-    let f = ex.frequency_grid(range_hz, points);
-    dir.write("frequency_response.csv", frequency_csv(ex, transfers, &f)?)?;
+    let (f, left_out) = finite_grid(ex, transfers, range_hz, points);
+    dir.write(
+        "frequency_response.csv",
+        frequency_csv(ex, transfers, &f, left_out)?,
+    )?;
     if !transfers.is_empty() {
         let curves: Vec<(String, Vec<(f64, faer::c64)>)> = transfers
             .iter()

@@ -20,7 +20,7 @@ mod tests;
 pub(crate) mod view3d;
 
 pub use arrays::{mat_bytes, npz_bytes, ArrayFileError, ArrayValue, NameProblem};
-pub use atomic::{OutputDir, MARKER};
+pub use atomic::{refuse_inputs_inside, OutputDir, MARKER};
 pub use deploy::{deploy_json, deploy_table, deployment_csv, write_deploy};
 pub use export::{export_json, export_table, flex_body_name, write_export};
 pub use modes::{modes_json, modes_table, write_modes};

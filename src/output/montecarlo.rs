@@ -37,10 +37,42 @@ pub struct ShardInfo {
 /// The fingerprint written with every shard: SHA-256 of the scenario text, the seed and the
 /// number of runs (shards of different analyses are never merged).
 pub fn fingerprint(text: &str, mc: &MonteCarlo) -> String {
-    let mut h = Sha256::new();
-    h.update(text.as_bytes());
-    h.update(format!("\nseed={}\nruns={}\n", mc.seed, mc.runs).as_bytes());
-    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
+    fingerprint_of(text, mc.seed, mc.runs)
+}
+
+fn fingerprint_of(text: &str, seed: u64, runs: u64) -> String {
+    sha256(format!("{text}\nseed={seed}\nruns={runs}\n").as_bytes())
+}
+
+/// SHA-256 in hexadecimal.
+fn sha256(bytes: &[u8]) -> String {
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+/// shard.json's format line; merge refuses any other.
+const SHARD_FORMAT: &str = "flexcraft Monte Carlo shard, version 2";
+
+/// The files of a shard whose SHA-256 shard.json records at write time, checked by merge.
+const SEALED: [&str; 3] = ["scenario.toml", "runs.csv", "torque_margin.csv"];
+
+/// The seal of shard.json: SHA-256 over its fields and its files' hashes, so that an edit of
+/// any of them (a run count, a shard number, a value in runs.csv) is found by merge.
+fn seal(info: &ShardInfo, files: &[String]) -> String {
+    sha256(
+        format!(
+            "{SHARD_FORMAT}\nhash={}\nseed={}\nruns={}\nshard={}\nshards={}\nfiles={}\n",
+            info.hash,
+            info.seed,
+            info.runs,
+            info.shard,
+            info.shards,
+            files.join(",")
+        )
+        .as_bytes(),
+    )
 }
 
 /// runs.csv: run, status, every applied value, every output.
@@ -407,19 +439,26 @@ pub fn write_montecarlo(
     records: &[RunRecord],
     margins: &[Vec<f64>],
 ) -> Result<Option<Analysis>, OutputError> {
-    dir.write("scenario.toml", scenario_text)?;
+    let runs = runs_csv(mc, names, records)?;
+    let margin = margin_csv(margins);
+    let bodies: [&[u8]; 3] = [scenario_text.as_bytes(), &runs, margin.as_bytes()];
+    let files: Vec<String> = bodies.iter().map(|b| sha256(b)).collect();
     let shard = json!({
-        "format": "flexcraft Monte Carlo shard, version 1",
+        "format": SHARD_FORMAT,
         "hash": info.hash, "seed": info.seed, "runs": info.runs,
         "shard": info.shard, "shards": info.shards,
         "split": "run i belongs to shard i mod shards",
+        "files": SEALED.iter().zip(&files).map(|(n, h)| (n.to_string(), json!(h)))
+            .collect::<serde_json::Map<String, Value>>(),
+        "seal": seal(info, &files),
     });
+    dir.write("scenario.toml", scenario_text)?;
     dir.write(
         "shard.json",
         serde_json::to_string_pretty(&shard).expect("plain JSON") + "\n",
     )?;
-    dir.write("runs.csv", runs_csv(mc, names, records)?)?;
-    dir.write("torque_margin.csv", margin_csv(margins))?;
+    dir.write("runs.csv", runs)?;
+    dir.write("torque_margin.csv", margin)?;
     if info.shards != 1 {
         return Ok(None);
     }
@@ -502,7 +541,7 @@ fn parse_num(s: &str, path: &Path, line: usize) -> Result<f64, MergeError> {
     })
 }
 
-fn read_info(dir: &Path) -> Result<ShardInfo, MergeError> {
+fn read_info(dir: &Path) -> Result<(ShardInfo, Vec<String>), MergeError> {
     let path = dir.join("shard.json");
     let bad = |reason: &str| MergeError::Malformed {
         path: path.clone(),
@@ -510,25 +549,104 @@ fn read_info(dir: &Path) -> Result<ShardInfo, MergeError> {
         reason: reason.to_string(),
     };
     let v: Value = serde_json::from_str(&read(&path)?).map_err(|e| bad(&e.to_string()))?;
+    if v["format"].as_str() != Some(SHARD_FORMAT) {
+        return Err(bad(&format!(
+            "format {} is not {SHARD_FORMAT:?} (a shard of another flexcraft version, or not a shard)",
+            v["format"]
+        )));
+    }
     let u = |k: &str| {
         v[k].as_u64()
             .ok_or_else(|| bad(&format!("no integer {k:?}")))
     };
-    Ok(ShardInfo {
-        hash: v["hash"]
-            .as_str()
-            .ok_or_else(|| bad("no \"hash\""))?
-            .to_string(),
+    let text = |k: &str| {
+        v[k].as_str()
+            .map(str::to_string)
+            .ok_or_else(|| bad(&format!("no {k:?}")))
+    };
+    let info = ShardInfo {
+        hash: text("hash")?,
         seed: u("seed")?,
         runs: u("runs")?,
         shard: u("shard")?,
         shards: u("shards")?,
-    })
+    };
+    let files = SEALED
+        .iter()
+        .map(|n| {
+            v["files"][n]
+                .as_str()
+                .map(str::to_string)
+                .ok_or_else(|| bad(&format!("no hash of {n} under \"files\"")))
+        })
+        .collect::<Result<Vec<String>, _>>()?;
+    if text("seal")? != seal(&info, &files) {
+        return Err(bad(
+            "its seal does not match its fields: shard.json was edited",
+        ));
+    }
+    Ok((info, files))
+}
+
+/// A shard's sealed files, each against the hash recorded when the shard was written, and
+/// the fingerprint against the scenario, seed and run count (before any of it is parsed).
+fn verify_files(dir: &Path, info: &ShardInfo, files: &[String]) -> Result<String, MergeError> {
+    let mut text = String::new();
+    for (name, want) in SEALED.iter().zip(files) {
+        let path = dir.join(name);
+        let body = std::fs::read(&path).map_err(|e| MergeError::Read {
+            path: path.clone(),
+            reason: e.to_string(),
+        })?;
+        if sha256(&body) != *want {
+            return Err(MergeError::Malformed {
+                path,
+                line: 0,
+                reason: "differs from what the shard wrote (its SHA-256 is not the one in \
+                         shard.json): the file was altered"
+                    .into(),
+            });
+        }
+        if *name == "scenario.toml" {
+            text = String::from_utf8(body).map_err(|_| MergeError::Malformed {
+                path: path.clone(),
+                line: 0,
+                reason: "not UTF-8".into(),
+            })?;
+        }
+    }
+    let bad = |reason: String| MergeError::Malformed {
+        path: dir.join("shard.json"),
+        line: 0,
+        reason,
+    };
+    if fingerprint_of(&text, info.seed, info.runs) != info.hash {
+        return Err(bad(
+            "its hash is not that of the scenario, seed and run count: shard.json was edited"
+                .into(),
+        ));
+    }
+    if info.runs == 0 || info.runs > crate::scenario::MAX_RUNS {
+        return Err(bad(format!(
+            "runs {} outside 1…{}",
+            info.runs,
+            crate::scenario::MAX_RUNS
+        )));
+    }
+    if info.shards == 0 || info.shards > crate::scenario::MAX_RUNS || info.shard >= info.shards {
+        return Err(bad(format!(
+            "shard {} of {} is not a shard of a split into 1…{} shards",
+            info.shard,
+            info.shards,
+            crate::scenario::MAX_RUNS
+        )));
+    }
+    Ok(text)
 }
 
 fn read_shard(dir: &Path, k_applied: usize, k_out: usize) -> Result<Shard, MergeError> {
-    let info = read_info(dir)?;
-    let text = read(&dir.join("scenario.toml"))?;
+    let (info, files) = read_info(dir)?;
+    let text = verify_files(dir, &info, &files)?;
     let path = dir.join("runs.csv");
     let body = read(&path)?;
     let mut rd = csv::Reader::from_reader(body.as_bytes());
@@ -613,7 +731,8 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         path: PathBuf::from("."),
         reason: "no shard folders given".into(),
     })?;
-    let text = read(&first.join("scenario.toml"))?;
+    let (first_info, files) = read_info(first)?;
+    let text = verify_files(first, &first_info, &files)?;
     let file = first.join("scenario.toml").display().to_string();
     let s = Scenario::from_toml_str(&text, &file).map_err(|e| MergeError::Malformed {
         path: first.join("scenario.toml"),
@@ -627,9 +746,8 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         });
     };
     let names = output_names(&s.structure, d, mc.response);
-    let first_info = read_info(first)?;
     mc.runs = first_info.runs;
-    let mut seen = vec![false; first_info.shards as usize];
+    let mut seen = std::collections::BTreeSet::new();
     let mut records = Vec::new();
     let mut curves = Vec::new();
     for dir in dirs {
@@ -650,7 +768,7 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
                 sh.info.shard, sh.info.shards, first_info.shards
             )));
         }
-        if std::mem::replace(&mut seen[sh.info.shard as usize], true) {
+        if !seen.insert(sh.info.shard) {
             return Err(mismatch(format!("shard {} is given twice", sh.info.shard)));
         }
         if sh.margins.len() != d.chain.hinges.len() {
@@ -673,7 +791,7 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         records.extend(sh.records);
         curves.push(sh.margins);
     }
-    if let Some(missing) = seen.iter().position(|s| !s) {
+    if let Some(missing) = (0..first_info.shards).find(|k| !seen.contains(k)) {
         return Err(MergeError::Mismatch {
             path: first.clone(),
             reason: format!("shard {missing} of {} is missing", first_info.shards),

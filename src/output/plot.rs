@@ -562,9 +562,16 @@ fn draw_bode<DB: DrawingBackend>(
     if f0 >= f1 {
         (f0, f1) = (0.1, 10.0);
     }
-    if m0 >= m1 {
-        (m0, m1) = (m0.min(1.0) * 0.5, m0.max(1.0) * 2.0);
+    if m0 > m1 {
+        // No finite, nonzero magnitude (an identically zero transfer: the log axis needs a
+        // range of its own; f64::MAX · 2 would make it infinite and plotters' ticks endless).
+        (m0, m1) = (0.5, 2.0);
+    } else if m0 == m1 {
+        (m0, m1) = (m0 * 0.5, m0 * 2.0);
     }
+    // Magnitudes near the ends of the floating-point range keep the axis finite.
+    m0 = m0.clamp(1e-290, 1e289);
+    m1 = m1.clamp(2.0 * m0, 1e290);
     let mut mag = ChartBuilder::on(&top)
         .caption(title, ("sans-serif", 20))
         .margin(12)

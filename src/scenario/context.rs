@@ -1,7 +1,7 @@
 //! The parsing context: the source text and file name, and the one way every section maps a
 //! refusal to `file:line:column: key: reason`.
 
-use super::error::{ErrorKind, Location, ScenarioError};
+use super::error::{ErrorKind, LineIndex, Location, ScenarioError};
 use super::raw::S;
 use crate::limits::Limit;
 use crate::structure::{Field, StructureError};
@@ -11,11 +11,20 @@ use std::ops::Range;
 pub(super) struct Ctx<'a> {
     pub(super) src: &'a str,
     pub(super) file: &'a str,
+    lines: LineIndex,
 }
 
-impl Ctx<'_> {
+impl<'a> Ctx<'a> {
+    pub(super) fn new(src: &'a str, file: &'a str) -> Self {
+        Self {
+            src,
+            file,
+            lines: LineIndex::new(src),
+        }
+    }
+
     pub(super) fn location(&self, span: &Range<usize>) -> Location {
-        Location::of_offset(self.src, span.start)
+        self.lines.locate(self.src, span.start)
     }
 
     pub(super) fn err(

@@ -26,17 +26,40 @@ pub struct Location {
 }
 
 impl Location {
-    /// Location of a byte offset in `src`.
+    /// Location of a byte offset in `src` (one scan of the text before it; for many lookups
+    /// in one text, [`LineIndex`]).
     pub fn of_offset(src: &str, offset: usize) -> Self {
-        let offset = offset.min(src.len());
-        let mut o = offset;
+        LineIndex::new(src).locate(src, offset)
+    }
+}
+
+/// The byte offsets where the lines of a text start: a location in O(log lines) (the
+/// scenario's parsing locates every component; a scan per lookup made 10 000 beams take
+/// seconds).
+#[derive(Debug, Clone)]
+pub struct LineIndex {
+    starts: Vec<usize>,
+}
+
+impl LineIndex {
+    /// The index of `src`.
+    pub fn new(src: &str) -> Self {
+        let starts = std::iter::once(0)
+            .chain(src.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Self { starts }
+    }
+
+    /// Location of a byte offset in `src` (the text this index was made of).
+    pub fn locate(&self, src: &str, offset: usize) -> Location {
+        let mut o = offset.min(src.len());
         while !src.is_char_boundary(o) {
             o -= 1;
         }
-        let before = &src[..o];
-        let line = before.matches('\n').count() + 1;
-        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-        Self {
+        // The last line start at or before o.
+        let line = self.starts.partition_point(|s| *s <= o);
+        let line_start = self.starts[line - 1];
+        Location {
             line,
             column: src[line_start..o].chars().count() + 1,
         }
@@ -97,6 +120,36 @@ impl std::fmt::Display for ScenarioError {
                 self.location.column,
                 truncate(&self.key, MAX_KEY_CHARS)
             )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The index's lookup against a scan of the text before each offset (the definition:
+    /// line = newlines before it + 1, column = characters since the last newline + 1), on a
+    /// text with multi-byte characters, empty lines and offsets inside a character or past
+    /// the end.
+    #[test]
+    fn the_line_index_locates_like_a_scan() {
+        let src = "a = 1\n\nname = \"κ → ω\"\r\n  x = [1, 2]\nlast";
+        let index = LineIndex::new(src);
+        for offset in 0..=src.len() + 3 {
+            let mut o = offset.min(src.len());
+            while !src.is_char_boundary(o) {
+                o -= 1;
+            }
+            let before = &src[..o];
+            let line = before.matches('\n').count() + 1;
+            let start = before.rfind('\n').map_or(0, |i| i + 1);
+            let column = src[start..o].chars().count() + 1;
+            assert_eq!(
+                index.locate(src, offset),
+                Location { line, column },
+                "offset {offset}"
+            );
         }
     }
 }

@@ -22,6 +22,7 @@ mod ritz;
 pub use budget::{default_memory_budget, format_bytes, Estimate, RunParts};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
 pub use error::{ErrorKind, Location, ScenarioError};
+pub use montecarlo::MAX_RUNS;
 pub use overrides::{apply_overrides, DeploymentOverrides, OverrideValue};
 
 use crate::deploy::Deployment;
@@ -187,6 +188,17 @@ impl Scenario {
             key: "(file)".into(),
             reason,
         };
+        // A FIFO or a device would block the open or the read with no end: only a regular
+        // file (or a symbolic link to one) is read.
+        let meta = std::fs::metadata(path).map_err(|e| io(e.to_string()))?;
+        if !meta.is_file() {
+            return Err(io(if meta.is_dir() {
+                "is a folder, not a scenario file".into()
+            } else {
+                "is not a regular file (a FIFO, socket or device): give the scenario as a file"
+                    .into()
+            }));
+        }
         let mut bytes = Vec::new();
         std::fs::File::open(path)
             .and_then(|f| f.take(MAX_SCENARIO_BYTES + 1).read_to_end(&mut bytes))
@@ -216,7 +228,7 @@ impl Scenario {
 
     /// Parses and validates scenario text; `file` names it in errors.
     pub fn from_toml_str(src: &str, file: &str) -> Result<Self, ScenarioError> {
-        let cx = Ctx { src, file };
+        let cx = Ctx::new(src, file);
         // Two stages, so that the kind of a refusal never depends on toml's wording: text
         // that is not TOML at all is a syntax error; TOML that does not fit the schema (an
         // unknown, missing or mistyped key) is a schema error.

@@ -86,7 +86,7 @@ fn lower_dispersion(
         let v = r.choice.as_ref().expect("one is given");
         let values = v.get_ref().clone();
         let weights = match &r.weights {
-            Some(w) => w.get_ref().clone(),
+            Some(w) => relative_weights(w.get_ref()),
             None => vec![1.0; values.len()],
         };
         (Distribution::Choice { values, weights }, v.span())
@@ -94,6 +94,20 @@ fn lower_dispersion(
     dist.validate()
         .map_err(|e| cx.invalid(span, &key, e.to_string()))?;
     Ok(dist)
+}
+
+/// A choice's weights as given, or, when their sum would overflow (each finite, e.g. two of
+/// 1e308), divided by the largest: only their ratios matter.
+fn relative_weights(w: &[f64]) -> Vec<f64> {
+    if w.iter().sum::<f64>().is_finite() {
+        return w.to_vec();
+    }
+    let top = w.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    if top.is_finite() && top > 0.0 {
+        w.iter().map(|x| x / top).collect()
+    } else {
+        w.to_vec()
+    }
 }
 
 /// One `[[montecarlo.requirements]]` entry.
@@ -105,6 +119,9 @@ fn lower_requirement(
 ) -> Result<Requirement, ScenarioError> {
     let r = q.get_ref();
     let key = |k: &str| format!("montecarlo.requirements[{i}].{k}");
+    if let Err(why) = crate::limits::valid_text("a requirement's name", r.name.get_ref()) {
+        return Err(cx.invalid(r.name.span(), key("name"), why));
+    }
     if !outputs.contains(r.output.get_ref()) {
         return Err(cx.invalid(
             r.output.span(),

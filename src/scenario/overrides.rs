@@ -272,10 +272,7 @@ impl DeploymentOverrides {
             ));
         }
         let text = apply_overrides(&self.text, values).map_err(|(p, why)| refuse(p, why))?;
-        let cx = super::context::Ctx {
-            src: &text,
-            file: &self.file,
-        };
+        let cx = super::context::Ctx::new(&text, &self.file);
         let raw: super::raw::RawDeploymentOnly =
             toml::from_str(&text).map_err(|e| super::toml_error(&cx, ErrorKind::Schema, &e))?;
         super::deployment::lower(&cx, &raw.deployment, &base.structure)

@@ -8,6 +8,24 @@ use toml::Spanned;
 
 pub type S<T> = Spanned<T>;
 
+/// A vector of exactly three numbers. serde reads `[f64; 3]` from the first three elements
+/// of a longer array and ignores the rest (`[0, 0, 0, "junk", nan]` was accepted): read the
+/// whole array and refuse any other length.
+fn three<'de, D: serde::Deserializer<'de>>(d: D) -> Result<S<[f64; 3]>, D::Error> {
+    let v: S<Vec<f64>> = S::deserialize(d)?;
+    let span = v.span();
+    let x = v.into_inner();
+    let a: [f64; 3] = x.as_slice().try_into().map_err(|_| {
+        serde::de::Error::invalid_length(x.len(), &"exactly three numbers [x, y, z]")
+    })?;
+    Ok(S::new(span, a))
+}
+
+/// [`three`] for an optional key.
+fn maybe_three<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<S<[f64; 3]>>, D::Error> {
+    three(d).map(Some)
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawScenario {
@@ -50,6 +68,7 @@ pub struct RawHub {
     pub motion: S<RawMotion>,
     pub mass: Option<S<f64>>,
     pub inertia: Option<S<Vec<f64>>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub center_of_mass: Option<S<[f64; 3]>>,
     pub shape: Option<S<RawHubShape>>,
 }
@@ -66,7 +85,9 @@ pub struct RawCylinder {
     pub diameter: S<f64>,
     pub wall: S<f64>,
     pub length: S<f64>,
+    #[serde(deserialize_with = "three")]
     pub axis: S<[f64; 3]>,
+    #[serde(deserialize_with = "three")]
     pub center: S<[f64; 3]>,
     pub material: S<String>,
     #[serde(default)]
@@ -98,6 +119,7 @@ pub struct RawSection {
     pub iz: Option<S<f64>>,
     pub torsion_constant: Option<S<f64>>,
     pub polar_inertia: Option<S<f64>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub y_axis: Option<S<[f64; 3]>>,
 }
 
@@ -114,8 +136,10 @@ pub struct RawBeamTerms {
 pub struct RawBeam {
     pub name: S<String>,
     pub parent: S<String>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub root: Option<S<[f64; 3]>>,
     pub station: Option<S<f64>>,
+    #[serde(deserialize_with = "three")]
     pub axis: S<[f64; 3]>,
     pub length: S<f64>,
     pub material: S<String>,
@@ -136,8 +160,11 @@ pub struct RawPlate {
     pub name: S<String>,
     pub parent: S<String>,
     pub station: Option<S<f64>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub root: Option<S<[f64; 3]>>,
+    #[serde(deserialize_with = "three")]
     pub length_axis: S<[f64; 3]>,
+    #[serde(deserialize_with = "three")]
     pub normal: S<[f64; 3]>,
     pub length: S<f64>,
     pub width: S<f64>,
@@ -155,7 +182,9 @@ pub struct RawMass {
     pub name: S<String>,
     pub parent: S<String>,
     pub station: Option<S<f64>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub point: Option<S<[f64; 3]>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub offset: Option<S<[f64; 3]>>,
     pub mass: S<f64>,
     pub inertia: Option<S<Vec<f64>>>,
@@ -318,6 +347,7 @@ pub struct RawPoint {
     pub station: Option<S<f64>>,
     pub xi: Option<S<f64>>,
     pub eta: Option<S<f64>>,
+    #[serde(default, deserialize_with = "maybe_three")]
     pub position: Option<S<[f64; 3]>>,
 }
 

@@ -91,8 +91,18 @@ fn hostile_names_are_refused_at_parse_time_and_nothing_is_written_anywhere() {
 #[test]
 fn oversized_and_non_utf8_files_are_refused_with_a_location() {
     let dir = scratch("files");
-    // /dev/zero is cut at 16 MiB instead of read to the end.
+    // A device (/dev/zero, endless) is not read at all; a 17 MiB file (sparse: zeros) is
+    // cut at 16 MiB instead of read to the end.
     let out = bin().args(["modes", "/dev/zero"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("not a regular file"));
+    let big = dir.join("big.toml");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(17 << 20)
+        .unwrap();
+    let out = bin().arg("modes").arg(&big).output().unwrap();
+    std::fs::remove_file(&big).unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("larger than 16 MiB"));
     // An invalid UTF-8 byte on line 5, column 8.

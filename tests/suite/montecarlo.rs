@@ -213,7 +213,7 @@ fn val_wilks_sample_sizes_match_the_published_table() {
 }
 
 /// A small fast Monte Carlo for the CLI tests.
-fn small(runs: u64, seed: u64) -> String {
+pub fn small(runs: u64, seed: u64) -> String {
     one_panel(&format!(
         r#"[montecarlo]
 runs = {runs}
@@ -235,19 +235,19 @@ confidence = 0.9
     ))
 }
 
-fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+pub fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
 }
 
-fn mc(args: &[&std::ffi::OsStr]) -> std::process::Output {
+pub fn mc(args: &[&std::ffi::OsStr]) -> std::process::Output {
     let o = bin().arg("montecarlo").args(args).output().unwrap();
     o
 }
 
 /// Every file of a folder (relative path → bytes).
-fn files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+pub fn files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
     let mut m = std::collections::BTreeMap::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
@@ -264,7 +264,7 @@ fn files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
     m
 }
 
-fn ok(o: &std::process::Output) {
+pub fn ok(o: &std::process::Output) {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 

@@ -1,0 +1,378 @@
+//! Issue 37, the second reliability sweep: each reproducer of the hostile sweep, as it was
+//! reported, behaves — a refusal with file, line, key and reason (exit 2, nothing written),
+//! or a finite result. Each test failed before its fix.
+
+use super::common::{bin, example, scratch};
+use super::hardening_input::{assert_refused, line_of, run};
+use super::montecarlo::{files, mc, ok, small, write};
+use std::ffi::OsStr;
+use std::path::Path;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Runs `cmd` and waits at most `limit` (a guard against a hang, not a speed check: the
+/// commands below take well under a second), killing it on expiry.
+fn within(mut cmd: Command, limit: Duration) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            panic!("still running after {limit:?}: a hang");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Item 1: a confidence so small that 1 − c rounds to 1 (an index out of bounds) and choice
+/// weights whose sum overflows ("validated: Overflow") run to the end.
+#[test]
+fn vanishing_confidences_and_huge_weights_run() {
+    let dir = scratch("rel_panics");
+    for (name, edit) in [
+        ("conf17", ("confidence = 0.9", "confidence = 1e-17")),
+        ("conf324", ("confidence = 0.9", "confidence = 5e-324")),
+        (
+            "weights",
+            (
+                "\"deployment.hinge.friction\" = { uniform = [0.0, 0.02] }",
+                "\"deployment.hinge.friction\" = { choice = [0.0, 0.02], weights = [1e308, 1e308] }",
+            ),
+        ),
+    ] {
+        let text = small(6, 3).replace(edit.0, edit.1);
+        assert!(text.contains(edit.1));
+        let scen = write(&dir, &format!("{name}.toml"), &text);
+        let out = dir.join(format!("{name}_out"));
+        let o = mc(&[
+            scen.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            "-q".as_ref(),
+        ]);
+        ok(&o);
+        let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+        assert!(!summary.contains("NaN"), "{name}");
+    }
+}
+
+/// Shards 0/2 and 1/2 of a small analysis in `dir`.
+fn two_shards(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let scen = write(dir, "s.toml", &small(8, 4));
+    let (a, b) = (dir.join("a"), dir.join("b"));
+    for (d, k) in [(&a, "0/2"), (&b, "1/2")] {
+        ok(&mc(&[
+            scen.as_os_str(),
+            "--out".as_ref(),
+            d.as_os_str(),
+            "--shard".as_ref(),
+            k.as_ref(),
+            "-q".as_ref(),
+        ]));
+    }
+    (a, b)
+}
+
+fn merge(a: &Path, b: &Path, out: &Path) -> Output {
+    mc(&[
+        "merge".as_ref(),
+        a.as_os_str(),
+        b.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
+}
+
+/// Items 1 and 10: merge verifies each shard against the hashes it recorded when written —
+/// an edited run count (a capacity overflow before), a value edited to NaN, inf or 1e999,
+/// swapped header names, junk in torque_margin.csv, another format version — and refuses
+/// with the file; `--out` onto an input shard is refused even with `--force`.
+#[test]
+fn merge_refuses_altered_shards() {
+    let dir = scratch("rel_merge");
+    let (a, b) = two_shards(&dir);
+    let m = dir.join("m");
+    ok(&merge(&a, &b, &m));
+    let pristine = files(&a);
+    type Edit = fn(&str) -> String;
+    let edits: [(&str, &str, Edit); 7] = [
+        ("shard.json", "runs", |s| {
+            s.replace("\"runs\": 8", "\"runs\": 18446744073709551615")
+        }),
+        ("shard.json", "format", |s| {
+            s.replace("version 2", "version 3")
+        }),
+        ("runs.csv", "NaN", |s| {
+            let mut rows: Vec<String> = s.lines().map(str::to_string).collect();
+            let mut cells: Vec<&str> = rows[1].split(',').collect();
+            let last = cells.len() - 1;
+            cells[last] = "NaN";
+            rows[1] = cells.join(",");
+            rows.join("\n") + "\n"
+        }),
+        ("runs.csv", "1e999", |s| {
+            let mut rows: Vec<String> = s.lines().map(str::to_string).collect();
+            let mut cells: Vec<&str> = rows[1].split(',').collect();
+            cells[2] = "1e999";
+            rows[1] = cells.join(",");
+            rows.join("\n") + "\n"
+        }),
+        ("runs.csv", "header", |s| {
+            let mut rows: Vec<String> = s.lines().map(str::to_string).collect();
+            let mut cells: Vec<&str> = rows[0].split(',').collect();
+            cells.swap(2, 3);
+            rows[0] = cells.join(",");
+            rows.join("\n") + "\n"
+        }),
+        ("torque_margin.csv", "junk", |s| {
+            s.to_string() + "junk,1,2\n"
+        }),
+        ("scenario.toml", "scenario", |s| {
+            s.replace("runs = 8", "runs = 9")
+        }),
+    ];
+    for (file, what, edit) in edits {
+        let p = a.join(file);
+        let text = std::fs::read_to_string(&p).unwrap();
+        let edited = edit(&text);
+        assert_ne!(edited, text, "{what}: the edit changed nothing");
+        std::fs::write(&p, edited).unwrap();
+        let out = dir.join(format!("m_{what}"));
+        let o = merge(&a, &b, &out);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert!(
+            err.contains(&a.display().to_string()) && err.contains("shard.json")
+                || err.contains(file),
+            "{what}: {err}"
+        );
+        assert!(!out.exists(), "{what}");
+        std::fs::write(&p, &text).unwrap();
+    }
+    assert!(files(&a) == pristine);
+    // --out onto one of the shards merged, with or without --force.
+    for force in [false, true] {
+        let mut args: Vec<&OsStr> = vec![
+            "merge".as_ref(),
+            a.as_os_str(),
+            b.as_os_str(),
+            "--out".as_ref(),
+            b.as_os_str(),
+        ];
+        if force {
+            args.push("--force".as_ref());
+        }
+        let o = mc(&args);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(stderr(&o).contains("holds the input"), "{}", stderr(&o));
+    }
+    ok(&merge(&a, &b, &dir.join("m2")));
+}
+
+/// Item 11: `--force` onto the folder that holds the scenario is refused (it deleted the
+/// scenario), for every command that writes a folder.
+#[test]
+fn force_onto_the_inputs_own_folder_is_refused() {
+    let dir = scratch("rel_force_input");
+    let inner = dir.join("case");
+    std::fs::create_dir_all(&inner).unwrap();
+    let scen = inner.join("seed.toml");
+    std::fs::copy(example("seed.toml"), &scen).unwrap();
+    for sub in ["modes", "deploy", "simulate", "export"] {
+        let o = bin()
+            .arg(sub)
+            .arg(&scen)
+            .arg("--out")
+            .arg(&inner)
+            .arg("--force")
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{sub}: {}", stderr(&o));
+        assert!(stderr(&o).contains("holds the input"), "{sub}");
+        assert!(scen.exists(), "{sub} deleted the scenario");
+    }
+}
+
+/// Item 2: an undamped export (`damping_ratio = 0`, or 1e-300) writes no NaN: the points
+/// where the response is infinite are left out and the header says how many.
+#[test]
+fn undamped_frequency_responses_have_no_nan() {
+    let dir = scratch("rel_undamped");
+    let src = std::fs::read_to_string(example("export.toml")).unwrap();
+    assert!(src.contains("damping_ratio = 0.005"));
+    for z in ["0.0", "1e-300"] {
+        let case = dir.join(z);
+        std::fs::create_dir_all(&case).unwrap();
+        let o = run(
+            &case,
+            "export",
+            src.replace("damping_ratio = 0.005", &format!("damping_ratio = {z}")),
+            &[],
+        );
+        ok(&o);
+        let csv = std::fs::read_to_string(case.join("out/frequency_response.csv")).unwrap();
+        let mut lines = csv.lines();
+        let header = lines.next().unwrap();
+        let rows: Vec<&str> = lines.collect();
+        assert!(rows.len() > 100, "{z}");
+        for r in &rows {
+            for cell in r.split(',') {
+                let v: f64 = cell.parse().unwrap();
+                assert!(v.is_finite(), "{z}: {r}");
+            }
+        }
+        if z == "1e-300" {
+            assert!(header.contains("left out"), "{header}");
+        }
+    }
+}
+
+/// Item 3: an identically zero transfer with `--out` (a fixed hub's torque to its attitude)
+/// ends (plotters' log axis spun on an infinite range); a FIFO as the scenario is refused,
+/// not waited on.
+#[test]
+fn a_zero_transfer_and_a_fifo_do_not_hang() {
+    let dir = scratch("rel_hangs");
+    let src = std::fs::read_to_string(example("tip_mass.toml")).unwrap()
+        + "\n[export]\n[[export.transfer]]\ninput = \"hub.tz\"\noutput = \"hub.rz\"\n";
+    let f = write(&dir, "zero.toml", &src);
+    let mut cmd = bin();
+    cmd.arg("export").arg(&f).arg("--out").arg(dir.join("zero"));
+    let o = within(cmd, Duration::from_secs(60));
+    ok(&o);
+    assert!(dir.join("zero/plots/bode.svg").exists());
+    let fifo = dir.join("fifo.toml");
+    let made = Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let mut cmd = bin();
+    cmd.arg("modes").arg(&fifo);
+    let o = within(cmd, Duration::from_secs(60));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not a regular file"), "{}", stderr(&o));
+}
+
+/// Item 4: `--jobs` is bounded (4 × the cores) and `--runs` obeys the file's cap of 10⁸.
+#[test]
+fn jobs_and_runs_are_bounded() {
+    let dir = scratch("rel_bounds");
+    let scen = write(&dir, "s.toml", &small(4, 1));
+    let out = dir.join("out");
+    for args in [
+        ["--jobs", "18446744073709551615"],
+        ["--jobs", "100000"],
+        ["--runs", "100000001"],
+    ] {
+        let o = mc(&[
+            scen.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+            args[0].as_ref(),
+            args[1].as_ref(),
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(args[0]), "{}", stderr(&o));
+        assert!(!out.exists());
+    }
+}
+
+/// Item 5: control characters in a requirement's name are refused like the title's.
+#[test]
+fn control_characters_in_requirement_names_are_refused() {
+    let dir = scratch("rel_names");
+    let src = small(4, 1).replace(
+        "name = \"latched within 1.3 s\"",
+        "name = \"\\u001b[2Jgone\\u0007\"",
+    );
+    let f = write(&dir, "s.toml", &src);
+    let out = dir.join("out");
+    let o = mc(&[f.as_os_str(), "--out".as_ref(), out.as_os_str()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    let line = line_of(&src, "\\u001b");
+    assert!(err.contains(&format!("s.toml:{line}:")), "{err}");
+    assert!(err.contains("montecarlo.requirements[0].name"), "{err}");
+    assert!(err.contains("control characters"), "{err}");
+    assert!(!err.contains('\u{1b}'), "the escape reached the terminal");
+    assert!(!out.exists());
+}
+
+/// Item 6: a vector of any length but three (a beam's root, an axis, an export point's
+/// position) is refused at its key, extra elements included.
+#[test]
+fn vectors_of_the_wrong_length_are_refused() {
+    let dir = scratch("rel_lengths");
+    // A string among the numbers: a type error at the element.
+    let seed0 = std::fs::read_to_string(example("seed.toml")).unwrap();
+    let junk = seed0.replacen(
+        "root = [0.0, 0.0, 0.0]",
+        "root = [0.0, 0.0, 0.0, \"junk\"]",
+        1,
+    );
+    let case = dir.join("junk");
+    std::fs::create_dir_all(&case).unwrap();
+    let o = run(&case, "modes", &junk, &[]);
+    assert_refused(
+        &case,
+        &o,
+        line_of(&junk, "\"junk\""),
+        "beams[0].root",
+        "\"junk\"",
+    );
+    let seed = std::fs::read_to_string(example("seed.toml")).unwrap();
+    let export = std::fs::read_to_string(example("export.toml")).unwrap();
+    let cases: [(&str, &str, &str, &str, &str); 5] = [
+        (
+            "modes",
+            &seed,
+            "root = [0.0, 0.0, 0.0]",
+            "root = [0.0, 0.0, 0.0, 0.0, nan]",
+            "beams[0].root",
+        ),
+        (
+            "modes",
+            &seed,
+            "root = [0.0, 0.0, 0.0]",
+            "root = [0.0, 0.0]",
+            "beams[0].root",
+        ),
+        (
+            "modes",
+            &seed,
+            "root = [0.0, 0.0, 0.0]",
+            "root = [0.0, 0.0, 0.0, 1.0]",
+            "beams[0].root",
+        ),
+        (
+            "modes",
+            &seed,
+            "\naxis = [0.0, 0.0, 1.0]",
+            "\naxis = [0.0, 0.0, 1.0, 0.0]",
+            "beams[0].axis",
+        ),
+        (
+            "export",
+            &export,
+            "position = [",
+            "position = [0.0, ",
+            "export.points[0].position",
+        ),
+    ];
+    for (k, (sub, src, from, to, key)) in cases.iter().enumerate() {
+        assert!(src.contains(from), "{from}");
+        let text = src.replacen(from, to, 1);
+        let case = dir.join(format!("c{k}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let o = run(&case, sub, &text, &[]);
+        let line = line_of(&text, to) + usize::from(to.starts_with('\n'));
+        assert_refused(&case, &o, line, key, "expected exactly three numbers");
+    }
+}
