@@ -137,7 +137,8 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         .parse()
         .map_err(|_| format!("not a size: {s:?} (e.g. 4G, 512M, 1000000)"))?;
     let bytes = v * (1u64 << shift) as f64;
-    if bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64 {
+    if bytes.is_finite() && bytes >= 1.0 {
+        // A limit above what a u64 holds is no limit: saturate (`as` does).
         Ok(bytes as u64)
     } else {
         Err(format!("not a size: {s:?} (e.g. 4G, 512M, 1000000)"))

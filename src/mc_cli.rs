@@ -110,7 +110,12 @@ fn auto_shard(shards: Option<u64>) -> Result<(u64, u64), String> {
             .ok_or("--shard auto: SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not")?;
         let count = int("SLURM_ARRAY_TASK_COUNT", count)?;
         let min = var("SLURM_ARRAY_TASK_MIN").map_or(Ok(0), |m| int("SLURM_ARRAY_TASK_MIN", m))?;
-        return check_shard(id.saturating_sub(min), count, "--shard auto (Slurm)");
+        if id < min {
+            return Err(format!(
+                "--shard auto (Slurm): SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"
+            ));
+        }
+        return check_shard(id - min, count, "--shard auto (Slurm)");
     }
     if let Some(idx) = var("AWS_BATCH_JOB_ARRAY_INDEX") {
         let idx = int("AWS_BATCH_JOB_ARRAY_INDEX", idx)?;
@@ -200,6 +205,26 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
         }
         pool = pool.num_threads(j);
     }
+    // The records of every run of the shard are held until the analysis: refused before the
+    // runs start when they would not fit.
+    let d = s.deployment.as_ref().expect("checked");
+    let runs_here = mc.runs / shards + u64::from(shard < mc.runs % shards);
+    let held = flexcraft::montecarlo::records_bytes(
+        &mc,
+        output_names(&s.structure, d, mc.response).len(),
+        d.chain.hinges.len(),
+        runs_here,
+    );
+    let budget = flexcraft::scenario::default_memory_budget();
+    if held > budget {
+        return Err(refuse(format!(
+            "{}: {runs_here} runs would hold about {} of records (limit {}, half the machine's \
+             memory): split them into shards (--shard I/N, merged after) or run fewer",
+            path.display(),
+            flexcraft::scenario::format_bytes(held),
+            flexcraft::scenario::format_bytes(budget)
+        )));
+    }
     let staged = prepare(Some(out), a.force, &[path])?.expect("an output folder");
     let pool = pool.build().map_err(|e| {
         eprintln!("error: starting the threads: {e}");
@@ -209,7 +234,6 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
     let progress = bar(indices.len() as u64, a.quiet);
     let records = pool.install(|| run_many(&s, &mc, &indices, &|| progress.inc(1)));
     progress.finish_and_clear();
-    let d = s.deployment.as_ref().expect("checked");
     let names = output_names(&s.structure, d, mc.response);
     let margins = worst_margins(d.chain.hinges.len(), records.iter().map(|r| &r.margins));
     let info = ShardInfo {

@@ -539,6 +539,20 @@ impl<'a> Runner<'a> {
     }
 }
 
+/// The memory the records of `runs` runs hold until the analysis (each run's applied values,
+/// outputs and torque-margin curves, with their allocations' headers; the run indices), an
+/// estimate checked before the runs start.
+pub fn records_bytes(mc: &MonteCarlo, outputs: usize, hinges: usize, runs: u64) -> u64 {
+    let vec = 24u64;
+    let per_run = 8 // the index
+        + 16 // status and padding
+        + 8 // the shard's index list
+        + 3 * vec
+        + 8 * (mc.dispersions.len() + outputs) as u64
+        + hinges as u64 * (vec + 8 * MARGIN_POINTS as u64);
+    runs.saturating_mul(per_run)
+}
+
 /// Runs `indices` on the current rayon pool (`on_done` after each run, from any thread);
 /// the records come back in the order of `indices`, whatever the threads.
 pub fn run_many(

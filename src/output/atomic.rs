@@ -5,13 +5,15 @@
 //! point, an existing non-directory, and an existing non-empty directory that flexcraft did not
 //! write (no [`MARKER`] file) unless `force`. It then takes an exclusive lock (a file
 //! `.NAME.lock` beside the target, so concurrent runs into one folder are serialised) and
-//! creates a hidden staging directory `.NAME.partial-PID` beside the *real* location of the
+//! creates a hidden staging directory `.NAME.partial-HOST-PID` beside the *real* location of the
 //! target (a symbolic link is resolved), on the same file system. Files are written into the
 //! staging directory; [`OutputDir::commit`] adds the marker and swaps the complete folder in
 //! with renames: the old folder, if any, is replaced as a whole, never merged. If anything fails,
 //! the value is dropped uncommitted, or the process gets SIGINT/SIGTERM, the staging directory,
 //! the lock file and any parent folder created for the target are removed and the old folder is
-//! left as it was.
+//! left as it was. A process killed without a chance to clean (SIGKILL, SIGQUIT) leaves its
+//! staging folder: the next run into the same target removes those of dead processes of its
+//! own host.
 
 use super::OutputError;
 use std::collections::{BTreeMap, BTreeSet};
@@ -300,8 +302,10 @@ impl OutputDir {
         me.lock = Some(lock(&lock_path, id)?);
         check_existing(&shown, &real, force)?;
         let pid = std::process::id();
-        me.staging = parent.join(format!(".{name}.partial-{pid}"));
-        me.backup = parent.join(format!(".{name}.old-{pid}"));
+        let host = host_name();
+        remove_stale_staging(&parent, &name, &host);
+        me.staging = parent.join(format!(".{name}.partial-{host}-{pid}"));
+        me.backup = parent.join(format!(".{name}.old-{host}-{pid}"));
         {
             let mut reg = registry();
             let c = reg.entry(id).or_default();
@@ -398,6 +402,62 @@ fn same_device(_: &std::fs::Metadata, _: &std::fs::Metadata) -> bool {
 /// Takes the exclusive lock on `path` (waiting for another run), registering the lock file
 /// for removal. The file is removed while locked when done; a waiter that then gets the lock
 /// of the removed file sees that the path no longer names it and tries again.
+/// This machine's name for the staging folders' names (Slurm nodes share storage: a PID means
+/// something only on its own host): Linux's /proc/sys/kernel/hostname, else `$HOSTNAME`, else
+/// "localhost"; characters other than ASCII letters, digits, '.' and '-' become '_'.
+fn host_name() -> String {
+    let raw = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+        .unwrap_or_else(|| "localhost".into());
+    raw.chars()
+        .take(64)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '.' | '-') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Whether process `pid` of this host is alive: Linux's /proc; elsewhere every process is
+/// taken as alive (nothing is removed).
+fn alive(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        Path::new("/proc").join(pid.to_string()).exists()
+    } else {
+        true
+    }
+}
+
+/// Removes the staging folders `.NAME.partial-HOST-PID` beside the target that a process of
+/// this host left when it was killed (SIGKILL, SIGQUIT: no handler ran) and that no live
+/// process owns. Called under the target's lock, so no live run of this target is staging;
+/// folders of other hosts are left alone (their PIDs cannot be checked from here).
+fn remove_stale_staging(parent: &Path, name: &str, host: &str) {
+    let prefix = format!(".{name}.partial-{host}-");
+    let Ok(entries) = std::fs::read_dir(parent) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(pid) = file
+            .to_str()
+            .and_then(|f| f.strip_prefix(&prefix))
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !alive(pid) {
+            remove_tree(&e.path());
+        }
+    }
+}
+
 fn lock(path: &Path, id: u64) -> Result<File, OutputError> {
     use fs4::fs_std::FileExt;
     loop {

@@ -359,7 +359,7 @@ pub fn export_arrays(
 }
 
 /// A name 42 accepts for the flexible body (its file names): the letters, digits, `_` and `-`
-/// of `stem` (others become `_`), at most 30 bytes; "spacecraft" when nothing is left.
+/// of `stem` (others become `_`), at most 29 bytes ([`super::flex42::MAX_BODY_NAME`]); "spacecraft" when nothing is left.
 pub fn flex_body_name(stem: &str) -> String {
     let s: String = stem
         .chars()
@@ -370,7 +370,7 @@ pub fn flex_body_name(stem: &str) -> String {
                 '_'
             }
         })
-        .take(30)
+        .take(super::flex42::MAX_BODY_NAME)
         .collect();
     if s.trim_matches('_').is_empty() {
         "spacecraft".to_string()

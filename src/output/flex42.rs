@@ -87,6 +87,9 @@ pub type Mat3 = [[f64; 3]; 3];
 
 /// Longest file name 42 stores (`char FlexFileName[40]`, with its terminating NUL).
 const MAX_FILE_NAME: usize = 39;
+/// The longest body name whose file names (`nodes_<name>.txt`, the longer) fit
+/// [`MAX_FILE_NAME`].
+pub const MAX_BODY_NAME: usize = MAX_FILE_NAME - "nodes_.txt".len();
 /// 42's line buffer (`char junk[80]`), with its terminating NUL.
 const MAX_LINE: usize = 79;
 /// Largest departure of the integrated modal mass matrix from 𝟙 that is accepted.
@@ -148,7 +151,7 @@ pub struct FlexNode {
 /// the body frame B, origin at the body's reference point (the clamp).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlexBody {
-    /// File-name stem: `flex_<name>.txt`, `nodes_<name>.txt` (1 to 30 bytes, no white space
+    /// File-name stem: `flex_<name>.txt`, `nodes_<name>.txt` (1 to [`MAX_BODY_NAME`] = 29 bytes, no white space
     /// or quote: 42 reads file names with `%s` into 40 bytes).
     pub name: String,
     /// The kept modes.
@@ -323,7 +326,7 @@ pub struct ParsedNode {
 #[non_exhaustive]
 pub enum Flex42Error {
     /// A body name that cannot make 42's file names.
-    #[error("flex body name {name:?}: must be 1 to 30 bytes without white space or quotes (42 reads file names with %s into 40 bytes)")]
+    #[error("flex body name {name:?}: must be 1 to 29 bytes without white space or quotes (42 reads file names, nodes_<name>.txt the longer, with %s into 40 bytes)")]
     BadName {
         /// The name.
         name: String,

@@ -14,7 +14,7 @@ pub use handover::{hand_over, Handover, HandoverMethod, Momentum};
 pub use superposition::{ModalResponse, ResponseHistory};
 
 /// Largest number of output rows a response may have.
-pub const MAX_ROWS: u64 = 10_000_000;
+pub const MAX_ROWS: u64 = 1_000_000;
 
 /// The `[response]` settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -176,7 +176,9 @@ impl Scenario {
             format_bytes(max_bytes)
         );
         let st = &self.structure;
-        if e.modes_bytes >= e.peak_bytes() / 2 {
+        // Without time series (modes, export) only the terms can be blamed.
+        let series = e.deployment_cells.max(e.response_cells) > 0;
+        if e.modes_bytes >= e.peak_bytes() / 2 || !series {
             let biggest = st
                 .beams
                 .iter()

@@ -195,7 +195,7 @@ fn bad_cases() -> Vec<(
             "duration = 60.0\noutput_rate = 50.0",
             "duration = 6e5\noutput_rate = 50.0",
             "response.output_rate",
-            "30000001 rows; the limit is 10000000",
+            "30000001 rows; the limit is 1000000",
         ),
         (
             "response damping",

@@ -175,7 +175,8 @@ fn sigterm_leaves_neither_the_folder_nor_staging_nor_lock() {
             .stderr(Stdio::null())
             .spawn()
             .unwrap();
-        let staging = dir.join(format!("new/.out.partial-{}", child.id()));
+        let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
+        let staging = dir.join(format!("new/.out.partial-{}-{}", host.trim(), child.id()));
         let start = Instant::now();
         while !staging.exists() {
             assert!(

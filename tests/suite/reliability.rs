@@ -376,3 +376,135 @@ fn vectors_of_the_wrong_length_are_refused() {
         assert_refused(&case, &o, line, key, "expected exactly three numbers");
     }
 }
+
+/// Item 9: a run killed without a chance to clean (SIGKILL; SIGQUIT likewise) leaves its
+/// staging folder `.NAME.partial-HOST-PID`; the next run into the same folder removes it
+/// (its process is dead, on this host), and leaves one of another host alone.
+#[test]
+fn the_next_run_removes_a_killed_runs_staging() {
+    let dir = scratch("rel_debris");
+    let seed = std::fs::read_to_string(example("seed.toml")).unwrap();
+    assert!(seed.contains("duration = 60.0"));
+    let file = write(
+        &dir,
+        "long.toml",
+        &seed.replace("duration = 60.0", "duration = 600.0"),
+    );
+    let out = dir.join("out");
+    let mut child = bin()
+        .arg("simulate")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
+    let staging = dir.join(format!(".out.partial-{}-{}", host.trim(), child.id()));
+    let start = Instant::now();
+    while !staging.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before staging"
+        );
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no staging folder"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(staging.exists(), "SIGKILL cleans nothing");
+    let foreign = dir.join(".out.partial-another-node-1");
+    std::fs::create_dir(&foreign).unwrap();
+    let o = bin()
+        .arg("deploy")
+        .arg(example("seed.toml"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    ok(&o);
+    assert!(!staging.exists(), "the dead run's staging is left");
+    assert!(foreign.exists(), "another host's staging was removed");
+}
+
+/// Item 4: budgets checked before the work starts — a deployment of more than 10⁶ rows is
+/// refused at its output rate (10⁷ was accepted), and 10⁸ Monte Carlo runs whose records
+/// would not fit half the machine's memory are refused before the first run.
+#[test]
+fn long_series_and_huge_run_counts_are_refused_up_front() {
+    let dir = scratch("rel_budgets");
+    let seed = std::fs::read_to_string(example("seed.toml")).unwrap();
+    // 70 s at 1e5 Hz: 7·10⁶ rows.
+    assert!(seed.contains("end_time = 70.0\noutput_rate = 10.0"));
+    let text = seed.replacen("output_rate = 10.0", "output_rate = 1e5", 1);
+    let o = run(&dir, "deploy", &text, &[]);
+    assert_refused(
+        &dir,
+        &o,
+        line_of(&text, "output_rate = 1e5"),
+        "deployment.output_rate",
+        "rows; the limit is 1000000",
+    );
+    let scen = write(&dir, "mc.toml", &small(4, 1));
+    let out = dir.join("mc_out");
+    let o = mc(&[
+        scen.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--runs".as_ref(),
+        "100000000".as_ref(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("of records"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+/// Item 11: a scenario stem over 29 characters still exports (42's flex body name is cut to
+/// fit `nodes_<name>.txt` in 40 bytes; it failed at write time), and Slurm's task id below
+/// the array's minimum is refused rather than taken as shard 0.
+#[test]
+fn long_stems_export_and_slurm_ids_below_the_minimum_are_refused() {
+    let dir = scratch("rel_small");
+    let src = std::fs::read_to_string(example("export.toml")).unwrap();
+    let f = write(
+        &dir,
+        "a_very_long_scenario_stem_name_over_thirty.toml",
+        &src,
+    );
+    let o = bin()
+        .arg("export")
+        .arg(&f)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    ok(&o);
+    let names: Vec<String> = std::fs::read_dir(dir.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let nodes = names.iter().find(|n| n.starts_with("nodes_")).unwrap();
+    assert!(nodes.len() <= 39, "{nodes}");
+    let scen = write(&dir, "mc.toml", &small(4, 1));
+    let o = bin()
+        .arg("montecarlo")
+        .arg(&scen)
+        .arg("--out")
+        .arg(dir.join("mc"))
+        .args(["--shard", "auto"])
+        .env("SLURM_ARRAY_TASK_ID", "0")
+        .env("SLURM_ARRAY_TASK_MIN", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "3")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("below SLURM_ARRAY_TASK_MIN"),
+        "{}",
+        stderr(&o)
+    );
+}
