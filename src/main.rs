@@ -184,7 +184,8 @@ fn not_finite(path: &Path, r: Result<(), flexcraft::finite::NonFinite>) -> Resul
     })
 }
 
-/// A failed modal solve, reported at the component it is traced to (exit status 1).
+/// A failed modal solve, reported at the component it is traced to (exit status 2: the
+/// scenario's values, not the machine, are the cause).
 fn numerical_failure(
     scenario: &Scenario,
     model: &RitzModel,
@@ -202,7 +203,7 @@ fn numerical_failure(
             )
         )
     );
-    ExitCode::from(FAILED)
+    ExitCode::from(REFUSED)
 }
 
 /// Checks, locks and stages the output directory before the computation: a target that must

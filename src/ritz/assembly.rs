@@ -457,6 +457,57 @@ impl RitzModel {
                 let worst = (0..n).fold(0, |w, i| if ratio(i) > ratio(w) { i } else { w });
                 self.component_at(worst)
             }
+            super::RitzError::NotFinite { .. } => {
+                // The heaviest component: the one out of scale with the rest.
+                let st = &self.structure;
+                let parts = std::iter::once((st.hub().mass(), ComponentId::Hub))
+                    .chain(
+                        st.beams()
+                            .iter()
+                            .enumerate()
+                            .map(|(i, b)| (b.mass(), ComponentId::Beam(i))),
+                    )
+                    .chain(
+                        st.plates()
+                            .iter()
+                            .enumerate()
+                            .map(|(i, p)| (p.mass(), ComponentId::Plate(i))),
+                    )
+                    .chain(
+                        st.masses()
+                            .iter()
+                            .enumerate()
+                            .map(|(i, m)| (m.mass(), ComponentId::Mass(i))),
+                    );
+                parts
+                    .fold((f64::NEG_INFINITY, ComponentId::Hub), |w, c| {
+                        if c.0 > w.0 {
+                            c
+                        } else {
+                            w
+                        }
+                    })
+                    .1
+            }
+        }
+    }
+
+    /// The error of a solve whose modes came out not finite: the decades the diagonal mass
+    /// of the components' coordinates spans.
+    pub fn not_finite(&self) -> super::RitzError {
+        let n = self.dof();
+        let diag = |i: usize| self.mass[(i, i)].abs();
+        // Over the components' own coordinates: the hub's six carry the whole structure's
+        // rigid mass and would always be the largest.
+        let first = if n > HUB_DOF { HUB_DOF } else { 0 };
+        let (lo, hi) = (first..n)
+            .map(diag)
+            .filter(|v| *v > 0.0)
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+        super::RitzError::NotFinite {
+            decades: (hi / lo).log10(),
         }
     }
 }

@@ -260,6 +260,17 @@ impl ModalAnalysis {
                 }
             }
         }
+        // Rounding past recovery (masses over too many decades) shows as a NaN or an
+        // infinity somewhere in a mode: an error, not a result.
+        let finite = modes
+            .iter()
+            .all(|m| m.omega_rad_s.is_finite() && m.shape.iter().all(|v| v.is_finite()))
+            && hub_fixed
+                .iter()
+                .all(|h| h.omega_rad_s.is_finite() && h.shape.iter().all(|v| v.is_finite()));
+        if !finite {
+            return Err(model.not_finite());
+        }
         strain_energy_shares(model, &mut modes);
         for (i, md) in modes.iter_mut().enumerate() {
             md.number = i + 1;

@@ -508,3 +508,50 @@ fn long_stems_export_and_slurm_ids_below_the_minimum_are_refused() {
         stderr(&o)
     );
 }
+
+/// Item 7: in-range inputs at the ends of the ranges give finite modes (a 3 µm tube with a
+/// 1 µm wall, a 10 km mast), or, where double precision cannot resolve them (a 10 km square
+/// plate on a 4 m boom: the mass matrix spans 20 decades), a refusal at the component out of
+/// scale — never a NaN, never exit 1 without a location.
+#[test]
+fn extreme_in_range_sizes_give_finite_modes_or_a_located_refusal() {
+    let dir = scratch("rel_extreme");
+    let seed = std::fs::read_to_string(example("seed.toml")).unwrap();
+    let modes_only = seed.split("[deployment]").next().unwrap().to_string();
+    for (k, (from, to)) in [
+        (
+            "section = { tube = { outer_diameter = 2.0, wall = 0.02 } }",
+            "section = { tube = { outer_diameter = 3e-6, wall = 1e-6 } }",
+        ),
+        ("length = 13.0", "length = 1e4"),
+    ]
+    .iter()
+    .enumerate()
+    {
+        assert!(modes_only.contains(from));
+        let case = dir.join(format!("finite{k}"));
+        std::fs::create_dir_all(&case).unwrap();
+        let o = run(
+            &case,
+            "modes",
+            modes_only.replacen(from, to, 1),
+            &["--json"],
+        );
+        ok(&o);
+        assert!(!String::from_utf8_lossy(&o.stdout).contains("NaN"), "{to}");
+    }
+    let full = std::fs::read_to_string(example("full.toml")).unwrap();
+    let from = "length = 6.0\nwidth = 2.0";
+    assert!(full.contains(from));
+    let text = full.replacen(from, "length = 1e4\nwidth = 1e4", 1);
+    let case = dir.join("plate");
+    std::fs::create_dir_all(&case).unwrap();
+    let o = run(&case, "modes", &text, &[]);
+    assert_refused(
+        &case,
+        &o,
+        line_of(&text, "name = \"wing\""),
+        "plates[0]",
+        "orders of magnitude",
+    );
+}
