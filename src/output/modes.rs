@@ -52,6 +52,7 @@ pub(crate) fn selection_json(modes: &ModalAnalysis) -> Value {
         "max_dof": sel.accuracy.max_dof,
         "dof": sel.dof,
         "reached": sel.reached,
+        "breakdown": sel.breakdown.as_ref().map(ToString::to_string),
         "max_frequency_error_estimate": sel.frequency_error.iter().copied().fold(0.0_f64, f64::max),
         "eigen_solves": sel.solves,
         "assemblies": sel.assemblies,
@@ -133,10 +134,14 @@ pub fn selection_line(sel: &crate::ritz::refine::TermSelection) -> String {
          (estimated error ≤ {:.1e}, {} coordinates, {} eigen-solves): {}",
         sel.accuracy.tolerance,
         sel.accuracy.modes,
-        if sel.reached {
-            "reached"
-        } else {
-            "NOT reached within max_dof"
+        match (&sel.breakdown, sel.reached) {
+            (Some(e), _) => format!(
+                "NOT reached: the refinement stopped where a finer level's solve broke down in \
+                 rounding ({e}; the polynomial terms' mass matrix grows ill-conditioned with \
+                 their count)"
+            ),
+            (None, true) => "reached".to_string(),
+            (None, false) => "NOT reached within max_dof".to_string(),
         },
         worst,
         sel.dof,

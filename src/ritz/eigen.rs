@@ -162,24 +162,25 @@ impl Operator {
         Self::from_triplets(n, &triplets)
     }
 
-    /// An n × n matrix from its non-zero entries (each (i, j) once).
+    /// An n × n matrix from its entries, those at the same (i, j) summed (an assembly adds
+    /// several components' contributions to one entry: a child beam's to its parent's
+    /// coordinates and the hub's). Both routes sum: faer's triplet constructor does, and so
+    /// must the dense one (it overwrote, and a beam-on-beam model's mass matrix came out
+    /// indefinite: issue 37).
     pub fn from_triplets(n: usize, triplets: &[Triplet<usize, usize, f64>]) -> Self {
-        if triplets.len() as f64 >= DENSE_ABOVE * (n * n) as f64 {
+        let dense = || {
             let mut a = Mat::zeros(n, n);
             for t in triplets {
-                a[(t.row, t.col)] = t.val;
+                a[(t.row, t.col)] += t.val;
             }
-            return Self::Dense(a);
+            Self::Dense(a)
+        };
+        if triplets.len() as f64 >= DENSE_ABOVE * (n * n) as f64 {
+            return dense();
         }
         match SparseColMat::try_new_from_triplets(n, n, triplets) {
             Ok(s) => Self::Sparse(s),
-            Err(_) => {
-                let mut a = Mat::zeros(n, n);
-                for t in triplets {
-                    a[(t.row, t.col)] = t.val;
-                }
-                Self::Dense(a)
-            }
+            Err(_) => dense(),
         }
     }
 
@@ -662,4 +663,40 @@ fn shifted_ritz(kr: &Mat<f64>, mr: &Mat<f64>, s: f64) -> Result<(Vec<f64>, Mat<f
     };
     let (shifted, z) = generalized_symmetric(&sym(kr, mr, s), &sym(mr, mr, 0.0))?;
     Ok((shifted.iter().map(|l| l - s).collect(), z))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Entries at the same place are summed on both routes: the sparse one (few entries)
+    /// and the dense one (many), against the sum done by hand.
+    #[test]
+    fn triplets_at_one_place_are_summed() {
+        for n in [2, 40] {
+            // Every entry twice (dense route for n = 2: 8 triplets ≥ 25 % of 4), or only the
+            // diagonal twice (sparse route for n = 40: 80 triplets < 400).
+            let mut t = Vec::new();
+            for i in 0..n {
+                for j in 0..n {
+                    if n == 2 || i == j {
+                        t.push(Triplet::new(i, j, (1 + i + j) as f64));
+                        t.push(Triplet::new(i, j, 0.5));
+                    }
+                }
+            }
+            let op = Operator::from_triplets(n, &t);
+            assert_eq!(matches!(op, Operator::Dense(_)), n == 2);
+            for i in 0..n {
+                for j in 0..n {
+                    let want = if n == 2 || i == j {
+                        (1 + i + j) as f64 + 0.5
+                    } else {
+                        0.0
+                    };
+                    assert_eq!(op.get(i, j), want, "n {n} ({i}, {j})");
+                }
+            }
+        }
+    }
 }

@@ -101,7 +101,11 @@ pub(super) fn select(
             cx.invalid(
                 span,
                 "ritz",
-                format!("the automatic term selection failed: {e}"),
+                format!(
+                    "the automatic term selection could not solve its first level for {modes} \
+                     modes ({e}): a limit of the selection's solver at this size, not a fault \
+                     of the structure; ask for fewer modes, or give every component its terms"
+                ),
             )
         })
 }
