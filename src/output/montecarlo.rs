@@ -205,8 +205,13 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
     s += "\noutput                          mean          sd            min           p50           p99           max\n";
     for (n, o) in &a.outputs {
         s += &format!(
-            "{n:<30} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e} {:>13.6e}\n",
-            o.mean, o.sd, o.min, o.percentiles[3], o.percentiles[6], o.max
+            "{n:<30} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
+            stat(o.mean),
+            stat(o.sd),
+            stat(o.min),
+            stat(o.percentiles[3]),
+            stat(o.percentiles[6]),
+            stat(o.max)
         );
     }
     s += "\nsensitivity (strongest parameter by |Spearman ρ|; SRRC: standardised rank regression coefficient, R² of the rank model)\n";
@@ -214,8 +219,11 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
         match r.ranking.first().filter(|p| p.spearman.is_finite()) {
             Some(p) => {
                 s += &format!(
-                    "{n:<30} {:<34} ρ = {:>7.3}  SRRC = {:>7.3}  R² = {:.3}\n",
-                    p.parameter, p.spearman, p.srrc, r.r2
+                    "{n:<30} {:<34} ρ = {:>7}  SRRC = {:>7}  R² = {}\n",
+                    p.parameter,
+                    three(p.spearman),
+                    three(p.srrc),
+                    three(r.r2)
                 )
             }
             None => s += &format!("{n:<30} – (constant)\n"),
@@ -240,8 +248,10 @@ pub fn montecarlo_table(info: &ShardInfo, a: &Analysis) -> String {
         );
         if let Some(p) = v.drivers.ranking.first().filter(|d| d.spearman.is_finite()) {
             s += &format!(
-                "  strongest driver of failures: {} (Spearman ρ = {:.3}, SRRC = {:.3})\n",
-                p.parameter, p.spearman, p.srrc
+                "  strongest driver of failures: {} (Spearman ρ = {}, SRRC = {})\n",
+                p.parameter,
+                three(p.spearman),
+                three(p.srrc)
             );
         }
     }
@@ -296,10 +306,10 @@ pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
             .filter(|d| d.spearman.is_finite())
             .map_or(String::new(), |p| {
                 format!(
-                    "{} (ρ = {:.3}, SRRC = {:.3})",
+                    "{} (ρ = {}, SRRC = {})",
                     esc(&p.parameter),
-                    p.spearman,
-                    p.srrc
+                    three(p.spearman),
+                    three(p.srrc)
                 )
             });
         h += &format!(
@@ -315,17 +325,9 @@ pub fn report(info: &ShardInfo, a: &Analysis, plots: &[String]) -> String {
         let (top, rho, srrc) = (rank.ranking.first())
             .filter(|d| d.spearman.is_finite())
             .map_or((String::new(), String::new(), String::new()), |p| {
-                (
-                    esc(&p.parameter),
-                    format!("{:.3}", p.spearman),
-                    format!("{:.3}", p.srrc),
-                )
+                (esc(&p.parameter), three(p.spearman), three(p.srrc))
             });
-        let r2 = if rank.r2.is_finite() {
-            format!("{:.3}", rank.r2)
-        } else {
-            "–".into()
-        };
+        let r2 = three(rank.r2);
         h += &format!(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{top}</td><td>{rho}</td><td>{srrc}</td><td>{r2}</td></tr>\n",
             esc(n), sig(o.mean), sig(o.sd), sig(o.min), sig(o.percentiles[3]), sig(o.percentiles[6]), sig(o.max)
@@ -425,6 +427,25 @@ fn margin_plot(dir: &mut OutputDir, margins: &[Vec<f64>]) -> Result<bool, Output
         false,
     )?;
     Ok(true)
+}
+
+/// A statistic in the terminal's table, "–" where the output has no finite value.
+fn stat(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.6e}")
+    } else {
+        "–".into()
+    }
+}
+
+/// A correlation or R² to three decimals, "–" where it is undetermined (NaN: a constant
+/// parameter, or fewer runs than parameters + 2 for the rank regression).
+fn three(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:.3}")
+    } else {
+        "–".into()
+    }
 }
 
 /// Writes a folder: the scenario text, shard.json, runs.csv and torque_margin.csv; when the

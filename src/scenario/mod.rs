@@ -152,6 +152,65 @@ fn table_path(src: &str, end: usize, header: &str) -> String {
     format!("{name}[{}]", index.saturating_sub(1))
 }
 
+/// The keys open at the end of `prefix` (a line's text up to an offset): the line's key, those
+/// of the inline tables entered since and the key whose value is being read, skipping quoted
+/// strings and array elements. Empty when no `key =` precedes the offset.
+fn inline_path(prefix: &str) -> Vec<String> {
+    let mut stack: Vec<String> = Vec::new();
+    let mut pending: Option<String> = None;
+    let mut word = String::new();
+    let mut arrays = Vec::new(); // array depth at each open inline table
+    let mut depth = 0usize; // arrays open in the current inline table
+    let mut chars = prefix.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' | '\'' => {
+                // Skip a quoted string (a basic string's escapes included).
+                let mut escaped = false;
+                for d in chars.by_ref() {
+                    if c == '"' && !escaped && d == '\\' {
+                        escaped = true;
+                        continue;
+                    }
+                    if d == c && !escaped {
+                        break;
+                    }
+                    escaped = false;
+                }
+                word.clear();
+            }
+            '#' => break,
+            '=' if depth == 0 => {
+                pending = Some(word.trim().to_string()).filter(|w| !w.is_empty());
+                word.clear();
+            }
+            '{' => {
+                if let Some(k) = pending.take() {
+                    stack.push(k);
+                }
+                arrays.push(depth);
+                depth = 0;
+                word.clear();
+            }
+            '}' => {
+                stack.pop();
+                depth = arrays.pop().unwrap_or(0);
+                pending = None;
+                word.clear();
+            }
+            '[' => depth += 1,
+            ']' => depth = depth.saturating_sub(1),
+            ',' if depth == 0 => {
+                pending = None;
+                word.clear();
+            }
+            _ => word.push(c),
+        }
+    }
+    stack.extend(pending);
+    stack
+}
+
 fn key_at(src: &str, offset: usize) -> String {
     let offset = offset.min(src.len());
     let line_start = src[..offset].rfind('\n').map_or(0, |i| i + 1);
@@ -167,7 +226,14 @@ fn key_at(src: &str, offset: usize) -> String {
         .map(str::trim)
         .find(|l| l.starts_with('['))
         .map(|l| table_path(src, line_start, l));
-    let key = line.split('=').next().unwrap_or("").trim().to_string();
+    // Inside an inline table the key is the innermost one at the offset
+    // (`section = { tube = { outer_diameter = "x" } }` → section.tube.outer_diameter).
+    let path = inline_path(&line[..offset - line_start]);
+    let key = if path.is_empty() {
+        line.split('=').next().unwrap_or("").trim().to_string()
+    } else {
+        path.join(".")
+    };
     match (header, key.is_empty() || !line.contains('=')) {
         (Some(h), false) => format!("{h}.{key}"),
         (Some(h), true) => h,
@@ -243,11 +309,34 @@ impl Scenario {
 }
 
 /// A refusal of toml's deserializer, located, with the key it points at.
+/// serde writes an unexpected float in full decimal (5e-324 with 324 digits): the shortest
+/// scientific form instead, in "floating point `…`".
+fn short_floats(msg: &str) -> String {
+    const TAG: &str = "floating point `";
+    let Some(at) = msg.find(TAG) else {
+        return msg.to_string();
+    };
+    let start = at + TAG.len();
+    let Some(len) = msg[start..].find('`') else {
+        return msg.to_string();
+    };
+    match msg[start..start + len].parse::<f64>() {
+        Ok(v) if len > 16 => format!("{}{v:e}{}", &msg[..start], &msg[start + len..]),
+        _ => msg.to_string(),
+    }
+}
+
 fn toml_error(cx: &Ctx, kind: ErrorKind, e: &toml::de::Error) -> ScenarioError {
     let span = e.span().unwrap_or(0..0);
     let mut msg = e.message().trim().to_string();
     if msg.is_empty() {
         msg = "malformed TOML here (a control character or an unexpected character)".to_string();
+    }
+    msg = short_floats(&msg);
+    // A dotted key (`motion.x = "free"`) makes a table where a text value belongs; serde's
+    // words for it ("expected a borrowed string") say nothing to a user.
+    if msg.ends_with("expected a borrowed string") {
+        msg = "a table (a dotted key) where a text value belongs: write `key = \"…\"`".into();
     }
     // serde names a missing field only in its message; put it into the key when it is there
     // (the location is the enclosing table either way).

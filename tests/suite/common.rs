@@ -156,6 +156,44 @@ pub fn scratch(name: &str) -> std::path::PathBuf {
     d
 }
 
+/// Starts `flexcraft simulate` on the seed with ten minutes of response (about a second of
+/// writing) into `out` (a folder named `out` in `parent`) and waits until its staging folder
+/// `parent/.out.partial-HOST-PID` exists: (the child, that folder).
+pub fn simulate_until_staging(
+    dir: &std::path::Path,
+    parent: &std::path::Path,
+) -> (std::process::Child, std::path::PathBuf) {
+    use std::time::{Duration, Instant};
+    let seed = std::fs::read_to_string(example("seed.toml")).unwrap();
+    assert!(seed.contains("duration = 60.0"));
+    let file = dir.join("long.toml");
+    std::fs::write(&file, seed.replace("duration = 60.0", "duration = 600.0")).unwrap();
+    let mut child = bin()
+        .arg("simulate")
+        .arg(&file)
+        .arg("--out")
+        .arg(parent.join("out"))
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
+    let staging = parent.join(format!(".out.partial-{}-{}", host.trim(), child.id()));
+    let start = Instant::now();
+    while !staging.exists() {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before staging"
+        );
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no staging folder"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    (child, staging)
+}
+
 /// The sorted names in a directory.
 pub fn entries(dir: &std::path::Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)

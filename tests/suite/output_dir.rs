@@ -6,9 +6,7 @@
 use super::common::{assert_same_tree, bin, entries, example, scratch, tree};
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
-
-const SEED: &str = include_str!("../../examples/seed.toml");
+use std::time::Duration;
 
 fn run(args: &[&std::ffi::OsStr]) -> std::process::Output {
     bin().args(args).output().unwrap()
@@ -162,33 +160,7 @@ fn sigterm_leaves_neither_the_folder_nor_staging_nor_lock() {
     #[cfg(unix)]
     {
         let dir = scratch("sigterm");
-        // Ten minutes of response at 50 Hz: about a second of writing.
-        let file = dir.join("long.toml");
-        std::fs::write(&file, SEED.replace("duration = 60.0", "duration = 600.0")).unwrap();
-        let out = dir.join("new/out");
-        let mut child = bin()
-            .arg("simulate")
-            .arg(&file)
-            .arg("--out")
-            .arg(&out)
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
-        let staging = dir.join(format!("new/.out.partial-{}-{}", host.trim(), child.id()));
-        let start = Instant::now();
-        while !staging.exists() {
-            assert!(
-                child.try_wait().unwrap().is_none(),
-                "finished before staging"
-            );
-            assert!(
-                start.elapsed() < Duration::from_secs(20),
-                "no staging folder"
-            );
-            std::thread::sleep(Duration::from_millis(2));
-        }
+        let (mut child, _) = super::common::simulate_until_staging(&dir, &dir.join("new"));
         std::thread::sleep(Duration::from_millis(100));
         let killed = Command::new("kill")
             .args(["-TERM", &child.id().to_string()])
