@@ -88,7 +88,7 @@ pub type Mat3 = [[f64; 3]; 3];
 /// Longest file name 42 stores (`char FlexFileName[40]`, with its terminating NUL).
 const MAX_FILE_NAME: usize = 39;
 /// The longest body name whose file names (`nodes_<name>.txt`, the longer) fit
-/// [`MAX_FILE_NAME`].
+/// 42's 39-byte file names.
 pub const MAX_BODY_NAME: usize = MAX_FILE_NAME - "nodes_.txt".len();
 /// 42's line buffer (`char junk[80]`), with its terminating NUL.
 const MAX_LINE: usize = 79;

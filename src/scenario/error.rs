@@ -27,7 +27,7 @@ pub struct Location {
 
 impl Location {
     /// Location of a byte offset in `src` (one scan of the text before it; for many lookups
-    /// in one text, [`LineIndex`]).
+    /// in one text, the parser's line index).
     pub fn of_offset(src: &str, offset: usize) -> Self {
         LineIndex::new(src).locate(src, offset)
     }
