@@ -547,10 +547,48 @@ struct Shard {
     margins: Vec<Vec<f64>>,
 }
 
-fn read(path: &Path) -> Result<String, MergeError> {
-    std::fs::read_to_string(path).map_err(|e| MergeError::Read {
+/// A shard's file as bytes: a regular file (a FIFO would block, a device never end) of at
+/// most `cap` bytes, checked before it is read.
+fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>, MergeError> {
+    use std::io::Read;
+    let fail = |reason: String| MergeError::Read {
         path: path.to_path_buf(),
-        reason: e.to_string(),
+        reason,
+    };
+    let meta = std::fs::metadata(path).map_err(|e| fail(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(fail("not a regular file".into()));
+    }
+    if meta.len() > cap {
+        return Err(fail(format!(
+            "{} bytes, more than a shard writes (at most {cap})",
+            meta.len()
+        )));
+    }
+    let mut body = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(cap + 1).read_to_end(&mut body))
+        .map_err(|e| fail(e.to_string()))?;
+    if body.len() as u64 > cap {
+        return Err(fail(format!("more than {cap} bytes")));
+    }
+    Ok(body)
+}
+
+/// The largest shard.json: a few hundred bytes are written.
+const SHARD_JSON_CAP: u64 = 64 << 10;
+
+/// The largest table file of a shard: a quarter of the memory budget (the records are held
+/// until the analysis).
+fn table_cap() -> u64 {
+    crate::scenario::default_memory_budget() / 4
+}
+
+fn utf8(path: &Path, body: Vec<u8>) -> Result<String, MergeError> {
+    String::from_utf8(body).map_err(|_| MergeError::Malformed {
+        path: path.to_path_buf(),
+        line: 0,
+        reason: "not UTF-8".into(),
     })
 }
 
@@ -569,7 +607,8 @@ fn read_info(dir: &Path) -> Result<(ShardInfo, Vec<String>), MergeError> {
         line: 0,
         reason: reason.to_string(),
     };
-    let v: Value = serde_json::from_str(&read(&path)?).map_err(|e| bad(&e.to_string()))?;
+    let text = utf8(&path, read_capped(&path, SHARD_JSON_CAP)?)?;
+    let v: Value = serde_json::from_str(&text).map_err(|e| bad(&e.to_string()))?;
     if v["format"].as_str() != Some(SHARD_FORMAT) {
         return Err(bad(&format!(
             "format {} is not {SHARD_FORMAT:?} (a shard of another flexcraft version, or not a shard)",
@@ -610,15 +649,18 @@ fn read_info(dir: &Path) -> Result<(ShardInfo, Vec<String>), MergeError> {
 }
 
 /// A shard's sealed files, each against the hash recorded when the shard was written, and
-/// the fingerprint against the scenario, seed and run count (before any of it is parsed).
-fn verify_files(dir: &Path, info: &ShardInfo, files: &[String]) -> Result<String, MergeError> {
-    let mut text = String::new();
+/// the fingerprint against the scenario, seed and run count (before any of it is parsed):
+/// the files' texts in [`SEALED`] order, the very bytes that were hashed.
+fn verify_files(dir: &Path, info: &ShardInfo, files: &[String]) -> Result<Vec<String>, MergeError> {
+    let mut texts = Vec::new();
     for (name, want) in SEALED.iter().zip(files) {
         let path = dir.join(name);
-        let body = std::fs::read(&path).map_err(|e| MergeError::Read {
-            path: path.clone(),
-            reason: e.to_string(),
-        })?;
+        let cap = if *name == "scenario.toml" {
+            crate::scenario::MAX_SCENARIO_BYTES
+        } else {
+            table_cap()
+        };
+        let body = read_capped(&path, cap)?;
         if sha256(&body) != *want {
             return Err(MergeError::Malformed {
                 path,
@@ -628,20 +670,15 @@ fn verify_files(dir: &Path, info: &ShardInfo, files: &[String]) -> Result<String
                     .into(),
             });
         }
-        if *name == "scenario.toml" {
-            text = String::from_utf8(body).map_err(|_| MergeError::Malformed {
-                path: path.clone(),
-                line: 0,
-                reason: "not UTF-8".into(),
-            })?;
-        }
+        texts.push(utf8(&path, body)?);
     }
+    let text = &texts[0];
     let bad = |reason: String| MergeError::Malformed {
         path: dir.join("shard.json"),
         line: 0,
         reason,
     };
-    if fingerprint_of(&text, info.seed, info.runs) != info.hash {
+    if fingerprint_of(text, info.seed, info.runs) != info.hash {
         return Err(bad(
             "its hash is not that of the scenario, seed and run count: shard.json was edited"
                 .into(),
@@ -662,14 +699,18 @@ fn verify_files(dir: &Path, info: &ShardInfo, files: &[String]) -> Result<String
             crate::scenario::MAX_RUNS
         )));
     }
-    Ok(text)
+    Ok(texts)
 }
 
 fn read_shard(dir: &Path, k_applied: usize, k_out: usize) -> Result<Shard, MergeError> {
     let (info, files) = read_info(dir)?;
-    let text = verify_files(dir, &info, &files)?;
+    let mut texts = verify_files(dir, &info, &files)?.into_iter();
+    let (text, body, mtext) = (
+        texts.next().unwrap_or_default(),
+        texts.next().unwrap_or_default(),
+        texts.next().unwrap_or_default(),
+    );
     let path = dir.join("runs.csv");
-    let body = read(&path)?;
     let mut rd = csv::Reader::from_reader(body.as_bytes());
     let mut records = Vec::new();
     for (i, row) in rd.records().enumerate() {
@@ -702,7 +743,6 @@ fn read_shard(dir: &Path, k_applied: usize, k_out: usize) -> Result<Shard, Merge
         });
     }
     let mpath = dir.join("torque_margin.csv");
-    let mtext = read(&mpath)?;
     let mut margins: Vec<Vec<f64>> = Vec::new();
     for (j, l) in mtext.lines().skip(1).enumerate() {
         let cells: Vec<&str> = l.split(',').skip(1).collect();
@@ -753,7 +793,7 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
         reason: "no shard folders given".into(),
     })?;
     let (first_info, files) = read_info(first)?;
-    let text = verify_files(first, &first_info, &files)?;
+    let text = verify_files(first, &first_info, &files)?.swap_remove(0);
     let file = first.join("scenario.toml").display().to_string();
     let s = Scenario::from_toml_str(&text, &file).map_err(|e| MergeError::Malformed {
         path: first.join("scenario.toml"),
@@ -797,13 +837,9 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
                 "torque_margin.csv does not match the hinges".into(),
             ));
         }
-        let expected = mc.shard_runs(sh.info.shard, sh.info.shards);
-        if sh
-            .records
-            .iter()
-            .map(|r| r.index)
-            .ne(expected.iter().copied())
-        {
+        // The runs i ≡ shard (mod shards), counted without a list of them.
+        let expected = (sh.info.shard..mc.runs).step_by(sh.info.shards.max(1) as usize);
+        if sh.records.iter().map(|r| r.index).ne(expected) {
             return Err(mismatch(format!(
                 "runs.csv does not hold exactly the runs of shard {}/{}",
                 sh.info.shard, sh.info.shards

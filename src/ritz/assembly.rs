@@ -458,31 +458,41 @@ impl RitzModel {
                 self.component_at(worst)
             }
             super::RitzError::NotFinite { .. } => {
-                // The heaviest component: the one out of scale with the rest.
+                // The component out of scale with the rest: its mass farthest, in decades,
+                // from the median of the components' masses (a 10 km plate on a 4 m boom,
+                // or a micrometre tube on a spacecraft).
                 let st = &self.structure;
-                let parts = std::iter::once((st.hub().mass(), ComponentId::Hub))
-                    .chain(
-                        st.beams()
-                            .iter()
-                            .enumerate()
-                            .map(|(i, b)| (b.mass(), ComponentId::Beam(i))),
-                    )
-                    .chain(
-                        st.plates()
-                            .iter()
-                            .enumerate()
-                            .map(|(i, p)| (p.mass(), ComponentId::Plate(i))),
-                    )
-                    .chain(
-                        st.masses()
-                            .iter()
-                            .enumerate()
-                            .map(|(i, m)| (m.mass(), ComponentId::Mass(i))),
-                    );
+                let parts: Vec<(f64, ComponentId)> =
+                    std::iter::once((st.hub().mass(), ComponentId::Hub))
+                        .chain(
+                            st.beams()
+                                .iter()
+                                .enumerate()
+                                .map(|(i, b)| (b.mass(), ComponentId::Beam(i))),
+                        )
+                        .chain(
+                            st.plates()
+                                .iter()
+                                .enumerate()
+                                .map(|(i, p)| (p.mass(), ComponentId::Plate(i))),
+                        )
+                        .chain(
+                            st.masses()
+                                .iter()
+                                .enumerate()
+                                .map(|(i, m)| (m.mass(), ComponentId::Mass(i))),
+                        )
+                        .filter(|(m, _)| *m > 0.0 && m.is_finite())
+                        .collect();
+                let mut logs: Vec<f64> = parts.iter().map(|(m, _)| m.log10()).collect();
+                logs.sort_by(f64::total_cmp);
+                let median = logs.get(logs.len() / 2).copied().unwrap_or(0.0);
                 parts
-                    .fold((f64::NEG_INFINITY, ComponentId::Hub), |w, c| {
-                        if c.0 > w.0 {
-                            c
+                    .iter()
+                    .fold((f64::NEG_INFINITY, ComponentId::Hub), |w, (m, id)| {
+                        let d = (m.log10() - median).abs();
+                        if d > w.0 {
+                            (d, *id)
                         } else {
                             w
                         }
@@ -507,7 +517,11 @@ impl RitzModel {
                 (lo.min(v), hi.max(v))
             });
         super::RitzError::NotFinite {
-            decades: (hi / lo).log10(),
+            decades: if hi > 0.0 && lo.is_finite() {
+                (hi / lo).log10()
+            } else {
+                0.0
+            },
         }
     }
 }

@@ -255,6 +255,9 @@ impl ModalAnalysis {
             Some((lam, phi)) => {
                 modes.extend(rigid_modes(model, &mrr));
                 for (j, &lambda) in lam.iter().enumerate() {
+                    if !lambda.is_finite() {
+                        return Err(model.not_finite());
+                    }
                     let shape = (0..n).map(|i| phi[(i, j)]).collect();
                     modes.push(elastic_mode(lambda, shape, None));
                 }
@@ -262,9 +265,10 @@ impl ModalAnalysis {
         }
         // Rounding past recovery (masses over too many decades) shows as a NaN or an
         // infinity somewhere in a mode: an error, not a result.
-        let finite = modes
-            .iter()
-            .all(|m| m.omega_rad_s.is_finite() && m.shape.iter().all(|v| v.is_finite()))
+        let finite = lam_f.iter().all(|l| l.is_finite())
+            && modes
+                .iter()
+                .all(|m| m.omega_rad_s.is_finite() && m.shape.iter().all(|v| v.is_finite()))
             && hub_fixed
                 .iter()
                 .all(|h| h.omega_rad_s.is_finite() && h.shape.iter().all(|v| v.is_finite()));

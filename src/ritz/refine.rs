@@ -225,7 +225,8 @@ pub struct TermSelection {
     /// Model assemblies made.
     pub assemblies: usize,
     /// Why the refinement stopped before the tolerance, when a finer level's solve broke
-    /// down in rounding (the level before it is the one reported).
+    /// down in rounding: the last level solved is reported, with estimates measured there
+    /// or at the level before it (larger: the frequencies fall as terms are added).
     pub breakdown: Option<RitzError>,
     /// The wanted modes' eigenvectors in the chosen model (columns, M-orthonormal), rows in
     /// the model's coordinate order: all of them for a free hub, the elastic ones for a fixed

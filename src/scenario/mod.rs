@@ -156,17 +156,22 @@ fn table_path(src: &str, end: usize, header: &str) -> String {
 /// of the inline tables entered since and the key whose value is being read, skipping quoted
 /// strings and array elements. Empty when no `key =` precedes the offset.
 fn inline_path(prefix: &str) -> Vec<String> {
+    // The keys of the inline tables open around the offset; for each, what to restore when it
+    // closes: the array depth and the key pending outside it (an array's key stays pending
+    // across its elements: `t = [{ n = 1 }, { n = "x" }]` → t.n for both).
     let mut stack: Vec<String> = Vec::new();
+    let mut saved: Vec<(usize, Option<String>, bool)> = Vec::new();
     let mut pending: Option<String> = None;
     let mut word = String::new();
-    let mut arrays = Vec::new(); // array depth at each open inline table
     let mut depth = 0usize; // arrays open in the current inline table
     let mut chars = prefix.chars();
     while let Some(c) = chars.next() {
         match c {
             '"' | '\'' => {
-                // Skip a quoted string (a basic string's escapes included).
+                // A quoted string (a basic string's escapes included): a quoted key if '='
+                // follows, a value otherwise (cleared by the ',' or '}' after it).
                 let mut escaped = false;
+                word.clear();
                 for d in chars.by_ref() {
                     if c == '"' && !escaped && d == '\\' {
                         escaped = true;
@@ -176,8 +181,8 @@ fn inline_path(prefix: &str) -> Vec<String> {
                         break;
                     }
                     escaped = false;
+                    word.push(d);
                 }
-                word.clear();
             }
             '#' => break,
             '=' if depth == 0 => {
@@ -185,17 +190,21 @@ fn inline_path(prefix: &str) -> Vec<String> {
                 word.clear();
             }
             '{' => {
-                if let Some(k) = pending.take() {
-                    stack.push(k);
-                }
-                arrays.push(depth);
+                let key = pending.clone();
+                saved.push((depth, pending.take(), key.is_some()));
+                stack.extend(key);
                 depth = 0;
                 word.clear();
             }
             '}' => {
-                stack.pop();
-                depth = arrays.pop().unwrap_or(0);
-                pending = None;
+                if let Some((d, p, pushed)) = saved.pop() {
+                    if pushed {
+                        stack.pop();
+                    }
+                    depth = d;
+                    // Inside an array its key stays pending; otherwise the value has ended.
+                    pending = if depth > 0 { p } else { None };
+                }
                 word.clear();
             }
             '[' => depth += 1,
@@ -553,5 +562,35 @@ fn sources(cx: &Ctx, raw: &RawScenario) -> Sources {
         text: cx.src.to_string(),
         at,
         keys,
+    }
+}
+
+#[cfg(test)]
+mod key_tests {
+    use super::inline_path;
+
+    /// The key open at the end of a line's prefix, against paths read off by hand.
+    #[test]
+    fn inline_paths_name_the_innermost_key() {
+        let cases: [(&str, &str); 9] = [
+            ("length = ", "length"),
+            (
+                "section = { tube = { outer_diameter = ",
+                "section.tube.outer_diameter",
+            ),
+            (
+                "section = { tube = { outer_diameter = 1, wall = ",
+                "section.tube.wall",
+            ),
+            ("a = { t = [ {n=1}, {n=", "a.t.n"),
+            ("a = { t = [ {n=1}, {n=\"x\"} ], z = ", "a.z"),
+            ("\"tube\" = { d = ", "tube.d"),
+            ("root = [0.0, ", "root"),
+            ("name = \"a = {b\", x = ", "x"),
+            ("# x = 1", ""),
+        ];
+        for (prefix, want) in cases {
+            assert_eq!(inline_path(prefix).join("."), want, "{prefix}");
+        }
     }
 }
