@@ -808,6 +808,22 @@ pub fn merge_shards(dirs: &[PathBuf]) -> Result<Merged, MergeError> {
     };
     let names = output_names(&s.structure, d, mc.response);
     mc.runs = first_info.runs;
+    // The merge holds every run's record, as the unsharded run would: refused before any
+    // other shard is read when they would not fit half the machine's memory.
+    let held = crate::montecarlo::records_bytes(&mc, names.len(), d.chain.hinges.len(), mc.runs);
+    let budget = crate::scenario::default_memory_budget();
+    if held > budget {
+        return Err(MergeError::Mismatch {
+            path: first.clone(),
+            reason: format!(
+                "the merged {} runs would hold about {} of records (limit {}, half the \
+                 machine's memory): merge on a machine with more memory",
+                mc.runs,
+                crate::scenario::format_bytes(held),
+                crate::scenario::format_bytes(budget)
+            ),
+        });
+    }
     let mut seen = std::collections::BTreeSet::new();
     let mut records = Vec::new();
     let mut curves = Vec::new();

@@ -743,3 +743,37 @@ fn schema_messages_name_the_inner_key_in_short_words() {
         assert!(stderr(&o).len() < 300, "{}", stderr(&o));
     }
 }
+
+/// A merge holds every run's record: one shard of 10⁸ runs (split into 10⁸ shards, one run
+/// each) is merged only where the records fit; here it is refused before anything else is
+/// read (or, on a machine with over 166 GB, for the shards missing).
+#[test]
+fn a_merge_that_would_not_fit_is_refused_first() {
+    let dir = scratch("rel_merge_memory");
+    let scen = write(&dir, "s.toml", &small(4, 1));
+    let shard = dir.join("shard");
+    ok(&mc(&[
+        scen.as_os_str(),
+        "--out".as_ref(),
+        shard.as_os_str(),
+        "--runs".as_ref(),
+        "100000000".as_ref(),
+        "--shard".as_ref(),
+        "0/100000000".as_ref(),
+        "-q".as_ref(),
+    ]));
+    let out = dir.join("merged");
+    let o = mc(&[
+        "merge".as_ref(),
+        shard.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("of records") || err.contains("is missing"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
