@@ -209,12 +209,9 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
     // runs start when they would not fit.
     let d = s.deployment.as_ref().expect("checked");
     let runs_here = mc.runs / shards + u64::from(shard < mc.runs % shards);
-    let held = flexcraft::montecarlo::records_bytes(
-        &mc,
-        output_names(&s.structure, d, mc.response).len(),
-        d.chain.hinges.len(),
-        runs_here,
-    );
+    let names = output_names(&s.structure, d, mc.response);
+    let held =
+        flexcraft::montecarlo::records_bytes(&mc, names.len(), d.chain.hinges.len(), runs_here);
     let budget = flexcraft::scenario::default_memory_budget();
     if held > budget {
         return Err(refuse(format!(
@@ -234,7 +231,6 @@ pub fn run(a: &Args) -> Result<(), ExitCode> {
     let progress = bar(indices.len() as u64, a.quiet);
     let records = pool.install(|| run_many(&s, &mc, &indices, &|| progress.inc(1)));
     progress.finish_and_clear();
-    let names = output_names(&s.structure, d, mc.response);
     let margins = worst_margins(d.chain.hinges.len(), records.iter().map(|r| &r.margins));
     let info = ShardInfo {
         hash: output::fingerprint(s.source_text(), &mc),
