@@ -508,6 +508,15 @@ pub fn write_montecarlo(
     Ok(Some(a))
 }
 
+/// `:LINE` for a line of a file, nothing for the whole file (line 0).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
+}
+
 /// Why shards could not be merged.
 #[derive(Debug, Error)]
 pub enum MergeError {
@@ -520,7 +529,7 @@ pub enum MergeError {
         reason: String,
     },
     /// A file is not what a shard writes.
-    #[error("{}:{line}: {reason}", path.display())]
+    #[error("{}{}: {reason}", path.display(), at_line(*line))]
     Malformed {
         /// The file.
         path: PathBuf,

@@ -358,13 +358,14 @@ impl ShiftInvert {
 /// Y ← Y L⁻ᵀ; the second pass removes the first one's loss of orthogonality), all in
 /// matrix products. When G is singular in rounding (a column dependent on the others) it
 /// falls back on modified Gram–Schmidt, which leaves such a column at rounding length (the
-/// Rayleigh–Ritz step then gives it an arbitrary direction). Returns M·Y, updated alongside Y.
+/// Rayleigh–Ritz step then leaves it out). Returns M·Y, updated alongside Y.
 fn m_orthonormalize(m: &Operator, y: &mut Mat<f64>) -> Mat<f64> {
     let mut my = m.apply(y);
     for _ in 0..2 {
         let g = y.transpose() * &my;
         let p = g.nrows();
         let g = Mat::from_fn(p, p, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
+        let before = (y.clone(), my.clone());
         match g.llt(Side::Lower) {
             Ok(llt) => {
                 // Y L⁻ᵀ = (L⁻¹ Yᵀ)ᵀ.
@@ -372,6 +373,13 @@ fn m_orthonormalize(m: &Operator, y: &mut Mat<f64>) -> Mat<f64> {
                     let mut t = a.transpose().to_owned();
                     llt.L().solve_lower_triangular_in_place(t.as_mut());
                     *a = t.transpose().to_owned();
+                }
+                // A factor whose pivots underflowed (G singular but for rounding) leaves
+                // non-finite columns: Gram–Schmidt from the block before instead.
+                if !all_finite(y) || !all_finite(&my) {
+                    (*y, my) = before;
+                    gram_schmidt(y, &mut my);
+                    break;
                 }
             }
             Err(_) => {
@@ -383,11 +391,20 @@ fn m_orthonormalize(m: &Operator, y: &mut Mat<f64>) -> Mat<f64> {
     my
 }
 
+/// Every entry of `a` is finite.
+fn all_finite(a: &Mat<f64>) -> bool {
+    a.col_iter().all(|c| c.iter().all(|v| v.is_finite()))
+}
+
 /// Modified Gram–Schmidt in the M inner product, twice ("twice is enough"), on Y and M·Y.
 fn gram_schmidt(y: &mut Mat<f64>, my: &mut Mat<f64>) {
     let (n, p) = (y.nrows(), y.ncols());
+    let length = |y: &Mat<f64>, my: &Mat<f64>, j: usize| -> f64 {
+        (0..n).map(|r| y[(r, j)] * my[(r, j)]).sum::<f64>().sqrt()
+    };
     for _ in 0..2 {
         for j in 0..p {
+            let before = length(y, my, j);
             for i in 0..j {
                 let c: f64 = (0..n).map(|r| y[(r, i)] * my[(r, j)]).sum();
                 for r in 0..n {
@@ -395,19 +412,43 @@ fn gram_schmidt(y: &mut Mat<f64>, my: &mut Mat<f64>) {
                     my[(r, j)] -= c * my[(r, i)];
                 }
             }
-            let norm: f64 = (0..n).map(|r| y[(r, j)] * my[(r, j)]).sum::<f64>().sqrt();
-            if norm > 0.0 && norm.is_finite() {
+            let norm = length(y, my, j);
+            if norm > DEPENDENT_LENGTH * before && norm.is_finite() {
                 for r in 0..n {
                     y[(r, j)] /= norm;
                     my[(r, j)] /= norm;
+                }
+            } else {
+                // Dependent on the columns before it but for rounding (normalised, that
+                // rounding would be a vector neither M-orthogonal to them nor meaningful), or
+                // not finite: zero, so that the Rayleigh–Ritz step leaves it out
+                // ([`shifted_ritz`]).
+                for r in 0..n {
+                    y[(r, j)] = 0.0;
+                    my[(r, j)] = 0.0;
                 }
             }
         }
     }
 }
 
+/// The fraction of its length a column must keep through [`gram_schmidt`]'s projections not
+/// to count as dependent on the columns before it.
+const DEPENDENT_LENGTH: f64 = 1e-10;
+
 /// Subspace iterations at most in [`lowest`].
 pub const LOWEST_MAX_ITERATIONS: usize = 400;
+
+/// Iterations with every wanted eigenvalue settled after which [`lowest_of`] accepts a
+/// residual up to [`FLOOR_RESIDUAL`].
+const STALLED_ITERATIONS: usize = 3;
+
+/// The relative residual accepted at the rounding floor (see [`STALLED_ITERATIONS`]).
+const FLOOR_RESIDUAL: f64 = 1e-6;
+
+/// An eigenvalue's change between iterations, relative to the largest wanted, that counts
+/// as settled at the rounding floor (where λ jitters by a few 1e-13).
+const STALLED_CHANGE: f64 = 1e-11;
 
 /// The `count` lowest eigenpairs of K φ = λ M φ (K symmetric positive semi-definite, M
 /// symmetric positive definite) without solving for the others: shift-invert subspace
@@ -423,7 +464,9 @@ pub const LOWEST_MAX_ITERATIONS: usize = 400;
 ///   error of λ_j falls by ((λ_j + s)/(λ_{p+1} + s))² per iteration.
 /// * Stops when each wanted λ has settled to 1e-13 and its residual ‖K x − λ M x‖ is below
 ///   1e-8 of ‖K x‖ + |λ| ‖M x‖ (the eigenvalue's error is quadratic in it; the high-order
-///   polynomial bases' conditioning leaves a rounding floor near 1e-11).
+///   polynomial bases' conditioning leaves a rounding floor near 1e-11 on small models, up
+///   to 1e-7 at hundreds of modes: once every λ has stayed settled for
+///   [`STALLED_ITERATIONS`], a residual up to [`FLOOR_RESIDUAL`] is accepted).
 ///
 /// Falls back on the dense [`generalized_symmetric`] when p would not be smaller than n or n
 /// is at most [`DENSE_BELOW`].
@@ -454,12 +497,16 @@ pub struct Lowest<'a> {
     pub start: Option<&'a Mat<f64>>,
 }
 
-/// True when [`lowest_of`] solves densely: the block would hold every mode, or the model is
-/// small and there is no start.
+/// True when [`lowest_of`] solves densely: the block would hold half the modes or more, or
+/// the model is small and there is no start. A block near the whole space gains nothing over
+/// the dense solve, and shift-invert crushes its columns' stiff components by (λ + s)⁻¹ —
+/// over a spectrum of many decades they become dependent in rounding (500 modes of the
+/// composite spacecraft's 1 014 coordinates: a 1 008-vector block whose reduced mass matrix
+/// had zero pivots).
 fn dense_route(n: usize, r: usize, count: usize, started: bool) -> bool {
     let count = count.min(n - r);
     let p = (2 * count + 8).min(n - r);
-    p >= n - r || (n <= DENSE_BELOW && !started)
+    2 * p >= n - r || (n <= DENSE_BELOW && !started)
 }
 
 /// The dense route: every mode, then the `count` lowest.
@@ -571,6 +618,7 @@ pub fn lowest_of(
         x[(i, given + j)] += 1.0;
     }
     let mut previous = vec![f64::INFINITY; count];
+    let mut stalled = 0;
     let mut mx = mo.apply(&x);
     for _ in 0..LOWEST_MAX_ITERATIONS {
         let mut y = mx;
@@ -587,11 +635,33 @@ pub fn lowest_of(
         let kr = y.transpose() * &ky;
         let mr = y.transpose() * &my;
         let (lambda, z) = shifted_ritz(&kr, &mr, s)?;
+        if lambda.len() < count {
+            // The block lost so many dependent columns that it no longer holds the modes.
+            return Err(RitzError::EigenNoConvergence);
+        }
         x = &y * &z;
         let zc = z.subcols(0, count);
         let kx = &ky * zc;
         mx = &my * &z;
         let scale = lambda[count - 1].abs().max(s);
+        let all_settled =
+            (0..count).all(|j| (lambda[j] - previous[j]).abs() <= STALLED_CHANGE * scale);
+        stalled = if all_settled { stalled + 1 } else { 0 };
+        // The residual's floor is the bases' conditioning times rounding (1e-7 for the
+        // composite spacecraft's hundredth mode at 450 coordinates): once every eigenvalue
+        // has stayed settled (to STALLED_CHANGE) for STALLED_ITERATIONS iterations, a residual
+        // up to FLOOR_RESIDUAL is that floor, not a lack of convergence (the eigenvalue's error is
+        // its square over the gap to the next one).
+        let bound = if stalled >= STALLED_ITERATIONS {
+            FLOOR_RESIDUAL
+        } else {
+            1e-8
+        };
+        let settle = if stalled >= STALLED_ITERATIONS {
+            STALLED_CHANGE
+        } else {
+            1e-13
+        };
         let converged = (0..count).all(|j| {
             let (mut rr, mut kn, mut mn) = (0.0_f64, 0.0_f64, 0.0_f64);
             for i in 0..n {
@@ -599,9 +669,9 @@ pub fn lowest_of(
                 kn += kx[(i, j)].powi(2);
                 mn += mx[(i, j)].powi(2);
             }
-            let settled = (lambda[j] - previous[j]).abs() <= 1e-13 * scale;
+            let settled = (lambda[j] - previous[j]).abs() <= settle * scale;
             settled
-                && rr.sqrt() <= 1e-8 * (kn.sqrt() + lambda[j].abs() * mn.sqrt()).max(s * mn.sqrt())
+                && rr.sqrt() <= bound * (kn.sqrt() + lambda[j].abs() * mn.sqrt()).max(s * mn.sqrt())
         });
         previous.copy_from_slice(&lambda[..count]);
         if converged {
@@ -661,9 +731,29 @@ fn shifted_ritz(kr: &Mat<f64>, mr: &Mat<f64>, s: f64) -> Result<(Vec<f64>, Mat<f
             0.5 * (a[(i, j)] + a[(j, i)]) + c * 0.5 * (b[(i, j)] + b[(j, i)])
         })
     };
+    // The block is M-orthonormal, so YᵀMY ≈ I but for columns the orthonormalisation left at
+    // rounding length (dependent on the others): those are left out of the reduced problem
+    // and of the block (Z has a row of zeros for each, and one column fewer).
+    let keep: Vec<usize> = (0..p).filter(|&j| mr[(j, j)] > DEPENDENT_COLUMN).collect();
+    if keep.len() < p {
+        let q = keep.len();
+        let pick = |a: &Mat<f64>| Mat::from_fn(q, q, |i, j| a[(keep[i], keep[j])]);
+        let (lambda, zk) = shifted_ritz(&pick(kr), &pick(mr), s)?;
+        let mut z = Mat::zeros(p, q);
+        for (i, &r) in keep.iter().enumerate() {
+            for j in 0..q {
+                z[(r, j)] = zk[(i, j)];
+            }
+        }
+        return Ok((lambda, z));
+    }
     let (shifted, z) = generalized_symmetric(&sym(kr, mr, s), &sym(mr, mr, 0.0))?;
     Ok((shifted.iter().map(|l| l - s).collect(), z))
 }
+
+/// The squared M-length below which a column of an M-orthonormalised block is taken as
+/// dependent on the others (the orthonormal ones have 1).
+const DEPENDENT_COLUMN: f64 = 1e-8;
 
 #[cfg(test)]
 mod tests {
