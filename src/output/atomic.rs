@@ -12,8 +12,9 @@
 //! the value is dropped uncommitted, or the process gets SIGINT/SIGTERM, the staging directory,
 //! the lock file and any parent folder created for the target are removed and the old folder is
 //! left as it was. A process killed without a chance to clean (SIGKILL, SIGQUIT) leaves its
-//! staging folder: the next run into the same target removes those of dead processes of its
-//! own host.
+//! staging folder (and, killed between the swap's two renames, the previous output as
+//! `.NAME.old-HOST-PID`): the next run into the same target removes those of dead processes of
+//! its own host, and puts such a backup back first where the target is missing.
 
 use super::OutputError;
 use std::collections::{BTreeMap, BTreeSet};
@@ -300,10 +301,10 @@ impl OutputDir {
         let name = name.to_string_lossy().into_owned();
         let lock_path = parent.join(format!(".{name}.lock"));
         me.lock = Some(lock(&lock_path, id)?);
-        check_existing(&shown, &real, force)?;
         let pid = std::process::id();
         let host = host_name();
         remove_stale_staging(&parent, &name, &host);
+        check_existing(&shown, &real, force)?;
         me.staging = parent.join(format!(".{name}.partial-{host}-{pid}"));
         me.backup = parent.join(format!(".{name}.old-{host}-{pid}"));
         {
@@ -434,26 +435,35 @@ fn alive(pid: u32) -> bool {
     }
 }
 
-/// Removes the staging folders `.NAME.partial-HOST-PID` beside the target that a process of
-/// this host left when it was killed (SIGKILL, SIGQUIT: no handler ran) and that no live
-/// process owns. Called under the target's lock, so no live run of this target is staging;
-/// folders of other hosts are left alone (their PIDs cannot be checked from here).
+/// Cleans what a process of this host left beside the target when it was killed (SIGKILL,
+/// SIGQUIT: no handler ran) and no live process owns: its staging folders
+/// `.NAME.partial-HOST-PID` are removed; its backup `.NAME.old-HOST-PID` (the previous
+/// output, moved aside while the new one was moved in) is put back as the target if the
+/// target is missing — the kill fell between the two renames — and removed otherwise. Called
+/// under the target's lock, so no live run of this target is staging; folders of other hosts
+/// are left alone (their PIDs cannot be checked from here).
 fn remove_stale_staging(parent: &Path, name: &str, host: &str) {
-    let prefix = format!(".{name}.partial-{host}-");
+    let dead = |file: &std::ffi::OsStr, kind: &str| -> bool {
+        let prefix = format!(".{name}.{kind}-{host}-");
+        file.to_str()
+            .and_then(|f| f.strip_prefix(&prefix))
+            .and_then(|p| p.parse::<u32>().ok())
+            .is_some_and(|pid| pid != std::process::id() && !alive(pid))
+    };
     let Ok(entries) = std::fs::read_dir(parent) else {
         return;
     };
+    let target = parent.join(name);
     for e in entries.flatten() {
         let file = e.file_name();
-        let Some(pid) = file
-            .to_str()
-            .and_then(|f| f.strip_prefix(&prefix))
-            .and_then(|p| p.parse::<u32>().ok())
-        else {
-            continue;
-        };
-        if pid != std::process::id() && !alive(pid) {
+        if dead(&file, "partial") {
             remove_tree(&e.path());
+        } else if dead(&file, "old") {
+            if std::fs::symlink_metadata(&target).is_err() {
+                let _ = std::fs::rename(e.path(), &target);
+            } else {
+                remove_tree(&e.path());
+            }
         }
     }
 }

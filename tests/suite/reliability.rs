@@ -379,7 +379,8 @@ fn vectors_of_the_wrong_length_are_refused() {
 
 /// Item 9: a run killed without a chance to clean (SIGKILL; SIGQUIT likewise) leaves its
 /// staging folder `.NAME.partial-HOST-PID`; the next run into the same folder removes it
-/// (its process is dead, on this host), and leaves one of another host alone.
+/// (its process is dead, on this host), and leaves one of another host alone; a dead run's
+/// backup of the previous output is put back where the output is missing, removed otherwise.
 #[test]
 fn the_next_run_removes_a_killed_runs_staging() {
     let dir = scratch("rel_debris");
@@ -400,6 +401,39 @@ fn the_next_run_removes_a_killed_runs_staging() {
     ok(&o);
     assert!(!staging.exists(), "the dead run's staging is left");
     assert!(foreign.exists(), "another host's staging was removed");
+    // A kill between moving the previous output aside (`.out.old-HOST-PID`) and moving the new
+    // one in: the next run puts the previous output back (and, not forced, refuses to replace
+    // it); forced, it replaces it and the backup is gone.
+    let dead = staging
+        .file_name()
+        .unwrap()
+        .to_str()
+        .unwrap()
+        .replacen(".out.partial-", ".out.old-", 1);
+    std::fs::remove_dir_all(&out).unwrap();
+    let backup = dir.join(&dead);
+    std::fs::create_dir(&backup).unwrap();
+    std::fs::write(backup.join("previous.txt"), "the previous output").unwrap();
+    let again = |force: bool| {
+        let mut c = bin();
+        c.arg("deploy").arg(example("seed.toml")).arg("--out").arg(&out);
+        if force {
+            c.arg("--force");
+        }
+        c.output().unwrap()
+    };
+    let o = again(false);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(!backup.exists());
+    assert_eq!(
+        std::fs::read_to_string(out.join("previous.txt")).unwrap(),
+        "the previous output"
+    );
+    std::fs::create_dir(&backup).unwrap();
+    std::fs::write(backup.join("previous.txt"), "an older output").unwrap();
+    ok(&again(true));
+    assert!(!backup.exists(), "the dead run's backup is left");
+    assert!(out.join("deployment.csv").exists() && !out.join("previous.txt").exists());
 }
 
 /// Item 4: budgets checked before the work starts — a deployment of more than 10⁶ rows is
