@@ -19,19 +19,41 @@ pub const MATRICES_PER_SOLVE: u64 = 20;
 /// Bytes of CSV text per number written (`1.2345678901234567e-5,`), rounded up.
 pub const CSV_BYTES_PER_NUMBER: u64 = 24;
 
-/// The default memory budget of a run: half of the machine's memory (Linux: MemTotal of
-/// /proc/meminfo), or 8 GiB when unknown.
+/// The default memory budget of a run: half of the memory this process may use — the
+/// machine's (Linux: MemTotal of /proc/meminfo) or, when lower, its control group's limit
+/// (cgroup v2 `memory.max`, v1 `memory.limit_in_bytes`: a container's or a Slurm job's) — or
+/// 8 GiB when neither is known.
 pub fn default_memory_budget() -> u64 {
-    std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|m| {
-            m.lines()
-                .find(|l| l.starts_with("MemTotal:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<u64>().ok())
-        })
-        .map_or(8 << 30, |kb| kb * 1024 / 2)
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|m| {
+        m.lines()
+            .find(|l| l.starts_with("MemTotal:"))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|kb| kb.parse::<u64>().ok())
+            .map(|kb| kb.saturating_mul(1024))
+    });
+    let group = [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ]
+    .iter()
+    .filter_map(|p| std::fs::read_to_string(p).ok())
+    .find_map(|t| cgroup_limit(&t));
+    match (total, group) {
+        (Some(t), Some(g)) => t.min(g) / 2,
+        (Some(b), None) | (None, Some(b)) => b / 2,
+        (None, None) => 8 << 30,
+    }
 }
+
+/// A control group's memory limit from its file's text: bytes, or None for "max" (v2) or a
+/// v1 "unlimited" (a number near 2⁶³).
+fn cgroup_limit(text: &str) -> Option<u64> {
+    text.trim()
+        .parse::<u64>()
+        .ok()
+        .filter(|&b| b > 0 && b < 1 << 62)
+}
+
 /// Memory of the program itself, bytes.
 pub const BASELINE_BYTES: u64 = 32 << 20;
 
@@ -219,5 +241,21 @@ mod tests {
     fn bytes_read_well() {
         assert_eq!(format_bytes(512), "512 B");
         assert_eq!(format_bytes(3 << 29), "1.5 GiB");
+    }
+}
+
+#[cfg(test)]
+mod cgroup_tests {
+    use super::cgroup_limit;
+
+    /// The limit files' forms: v2 "max" and v1's page-rounded 2⁶³ mean no limit; a number is
+    /// one.
+    #[test]
+    fn cgroup_limits_are_read_or_taken_as_none() {
+        assert_eq!(cgroup_limit("max\n"), None);
+        assert_eq!(cgroup_limit("9223372036854771712\n"), None);
+        assert_eq!(cgroup_limit("2147483648\n"), Some(2 << 30));
+        assert_eq!(cgroup_limit("0"), None);
+        assert_eq!(cgroup_limit("junk"), None);
     }
 }
