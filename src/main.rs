@@ -47,7 +47,8 @@ struct Common {
     #[arg(long, requires = "out")]
     force: bool,
     /// Refuse a run whose estimated peak memory exceeds this many bytes (suffixes K, M, G,
-    /// T: powers of 1024). Default: half of the memory the process may use (the machine's, or its control group's limit when lower).
+    /// T: powers of 1024). Default: half of the memory the process may use (the machine's,
+    /// or its control group's limit when lower).
     #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
     max_memory: Option<u64>,
 }
