@@ -25,7 +25,9 @@ mod suite {
     pub mod export;
     pub mod hardening_input;
     pub mod hardening_output;
+    pub mod hinge_closed_forms;
     pub mod implicit;
+    pub mod independent_truths;
     pub mod modal_properties;
     pub mod montecarlo;
     pub mod mutations;

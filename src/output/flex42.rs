@@ -1675,6 +1675,33 @@ mod tests {
         assert!(j_sum > 0.9 * j_zz, "{j_sum} of {j_zz}");
     }
 
+    #[test]
+    fn participations_equal_the_modes_root_loads() {
+        // The truth, from the mode's own equation and tip conditions rather than quadrature:
+        // integrating EI φ'''' = ω² μ φ over the beam, with EI φ'''(ℓ) = −ω² M_t φ(ℓ) and
+        // EI φ''(ℓ) = ω² j φ'(ℓ) at the tip, gives the participations as the root's shear and
+        // moment per ω²: ∫μφ dx + M_t φ(ℓ) = −(EI/ω²) φ'''(0) = −2Bμ/β, and
+        // ∫μxφ dx + M_t ℓ φ(ℓ) + j φ'(ℓ) = (EI/ω²) φ''(0) = 2Aμ/β² (φ = A(cosh βx − cos βx)
+        // + B(sinh βx − sin βx), EI/ω² = μ/β⁴). To 1e-9: the flex body's composite Gauss rule
+        // integrates the fifth mode's x·φ to 2.5e-10.
+        let modes = beam_modes(5);
+        let got = modal_integrals(&body(&modes)).unwrap();
+        for (p, m) in modes.iter().enumerate().filter(|(_, m)| m.axis == 1) {
+            let pf = -2.0 * m.b * MU / m.beta;
+            let hf = 2.0 * m.a * MU / (m.beta * m.beta);
+            assert!(
+                (got.pf[p][1] - pf).abs() <= 1e-9 * pf.abs(),
+                "Pf {p}: {} vs {pf}",
+                got.pf[p][1]
+            );
+            assert!(
+                (got.hf[p][2] - hf).abs() <= 1e-9 * hf.abs(),
+                "Hf {p}: {} vs {hf}",
+                got.hf[p][2]
+            );
+        }
+    }
+
     fn dense_shapes(entries: &[ShapeEntry], index: usize, nf: usize) -> Vec<Vec3> {
         let mut out = vec![[0.0; 3]; nf];
         for e in entries.iter().filter(|e| e.index == index) {

@@ -176,8 +176,10 @@ fn the_default_settling_ends_when_the_latch_has_decayed_or_at_its_cap() {
 /// As the latch stiffness grows at a fixed damping ratio (c_L ∝ √k_L), the rate some latch
 /// periods after capture tends to the plastic impact's post-impact rate (zero for one panel
 /// on a held hub) and the energy the latch takes to the impact's loss; the hinge angle tends
-/// to the latch angle. Here: the panel's residual energy of motion relative to its static
-/// equilibrium (which tends to the latch angle) falls monotonically.
+/// to the latch angle. Here, eight seconds after the capture, the hinge rests at its static
+/// equilibrium, whose offset from the latch angle is the closed form k (α_ref − α_L)/(k + k_L)
+/// (hinge spring against latch spring), within what the damped oscillator's envelope leaves
+/// of the capture's vibration, and so falls towards zero as k_L grows.
 #[test]
 fn stiffer_latches_tend_to_the_plastic_impact() {
     let mut last = f64::INFINITY;
@@ -192,11 +194,30 @@ fn stiffer_latches_tend_to_the_plastic_impact() {
         let end = r.samples.last().unwrap();
         let h = &c.chain.hinges[0];
         let off = (end.alpha[0] - h.latch_angle).abs();
+        let static_offset =
+            (h.stiffness * (h.reference_angle - h.latch_angle) / (h.stiffness + kl)).abs();
+        // What is left of the capture's vibration: the damped oscillator's envelope
+        // (|x₀| + |ẋ₀|/ω_d) e^{−ζω_n t} (x₀ = the static offset, ẋ₀ the capture rate).
+        let p = &c.chain.panels[0];
+        let j = c.panel_inertia[0][2] + 0.25 * p.mass * p.length * p.length;
+        let wn = ((h.stiffness + kl) / j).sqrt();
+        let zeta = cl / (2.0 * (j * (h.stiffness + kl)).sqrt());
+        let wd = wn * (1.0 - zeta * zeta).sqrt();
+        let after = end.t - r.captures[0].time;
+        let left = (static_offset + r.captures[0].rates[0].abs() / wd) * (-zeta * wn * after).exp();
+        assert!(
+            (off - static_offset).abs() <= left + 1e-9,
+            "k_L = {kl}: |α − α_L| = {off}, static {static_offset}, vibration left ≤ {left:e}"
+        );
         assert!(
             off < last,
             "k_L = {kl}: |α − α_L| = {off} (previous {last})"
         );
-        assert!(end.rate[0].abs() < 1e-3, "k_L = {kl}: rate {}", end.rate[0]);
+        assert!(
+            end.rate[0].abs() <= wn * left / (1.0 - zeta * zeta).sqrt() + 1e-9,
+            "k_L = {kl}: rate {}",
+            end.rate[0]
+        );
         last = off;
     }
 }
@@ -559,11 +580,86 @@ fn the_latch_period_is_the_captured_arrays_slowest_mode() {
     let cable = two_pi * (m * l * l / (9.0 * (k + kl[0]))).sqrt();
     let w = latch_period(&c.chain, kl, Synchronisation::IdealCable);
     assert!((w - cable).abs() < 1e-12 * cable, "{w} vs {cable}");
-    // Without the cable the slowest mode is that of the whole array on its three latches:
-    // slower than one panel alone on its latch.
-    let alone = two_pi * (m * l * l / 3.0 / (k + kl[0])).sqrt();
+    // Without the cable the slowest mode is that of the whole array on its three latches: the
+    // straight chain of rigid panels (hub held) linearised here in absolute angles θ_j — the
+    // centre of panel j moves across by Σ_{i<j} l_i θ̇_i + (l_j/2) θ̇_j, so
+    // M_ik = Σ_j m_j c_ji c_jk + δ_ik I_j (c_ji = l_i for i < j, l_j/2 for i = j), and the
+    // hinge and latch springs act on the relative angles, V = ½ Σ_i (k_i + k_L,i)(θ_i − θ_{i−1})²
+    // — its lowest root of det(K − ω²M) = 0 found by scanning and bisection.
+    let n = c.chain.panels.len();
+    let coef = |j: usize, i: usize| -> f64 {
+        let l = c.chain.panels[i].length;
+        if i < j {
+            l
+        } else if i == j {
+            l / 2.0
+        } else {
+            0.0
+        }
+    };
+    let mm: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|k| {
+                    let own = if i == k {
+                        c.chain.panels[i].inertia
+                    } else {
+                        0.0
+                    };
+                    own + (0..n)
+                        .map(|j| c.chain.panels[j].mass * coef(j, i) * coef(j, k))
+                        .sum::<f64>()
+                })
+                .collect()
+        })
+        .collect();
+    let spring = |i: usize| c.chain.hinges[i].stiffness + kl[i];
+    let kk: Vec<Vec<f64>> = (0..n)
+        .map(|i| {
+            (0..n)
+                .map(|k| {
+                    let mut v = 0.0;
+                    if i == k {
+                        v += spring(i) + if i + 1 < n { spring(i + 1) } else { 0.0 };
+                    }
+                    if k == i + 1 {
+                        v -= spring(k);
+                    }
+                    if i == k + 1 {
+                        v -= spring(i);
+                    }
+                    v
+                })
+                .collect()
+        })
+        .collect();
+    assert_eq!(n, 3);
+    let det = |w2: f64| {
+        let a = |i: usize, k: usize| kk[i][k] - w2 * mm[i][k];
+        a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1))
+            - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
+            + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0))
+    };
+    let (mut lo, mut step) = (0.0, 1e-6 * spring(0) / mm[0][0]);
+    while det(lo + step).signum() == det(lo).signum() {
+        lo += step;
+        step *= 1.01;
+    }
+    let mut hi = lo + step;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if det(mid).signum() == det(lo).signum() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let chain = two_pi / (0.5 * (lo + hi)).sqrt();
     let free = latch_period(&c.chain, kl, Synchronisation::None);
-    assert!(free > 1.5 * alone, "{free} vs one panel's {alone}");
+    assert!((free - chain).abs() < 1e-9 * chain, "{free} vs {chain}");
+    // Slower than one panel alone on its latch.
+    let alone = two_pi * (m * l * l / 3.0 / (k + kl[0])).sqrt();
+    assert!(free > alone, "{free} vs one panel's {alone}");
 }
 
 /// The hand-over after compliant latches reports the latch springs' energy it cannot carry,

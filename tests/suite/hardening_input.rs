@@ -354,8 +354,6 @@ fn a_direction_of_any_scale_gives_the_same_modes() {
         let f = freqs(&FREE_HUB.replace("normal = [0.0, 0.0, 1.0]", &format!("normal = {scaled}")));
         assert_eq!(f, base, "{scaled}");
     }
-    let f1 = base.iter().find(|w| **w > 1e-6).unwrap() / (2.0 * std::f64::consts::PI);
-    assert!((f1 - 1.584).abs() < 1e-3, "{f1}");
 }
 
 #[test]

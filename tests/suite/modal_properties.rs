@@ -126,9 +126,11 @@ fn effective_mass_sum_rises_towards_appendage_mass() {
         eprintln!("terms beam ({b},{t},{a}) plate {pl}×{pw}: effective-mass fractions {frac:.6?}");
         for d in 0..6 {
             assert!(frac[d] <= 1.0 + 1e-10, "direction {d}: {}", frac[d]);
+            // Towards the limit 1 (Parseval): what is missing at least halves with each
+            // refinement (the terms roughly doubled; measured 2.8–4.2×).
             assert!(
-                frac[d] >= prev[d] - 1e-12,
-                "direction {d} fell: {} < {}",
+                1.0 - frac[d] <= 0.5 * (1.0 - prev[d]),
+                "direction {d} does not converge to 1: {} after {}",
                 frac[d],
                 prev[d]
             );
@@ -136,7 +138,7 @@ fn effective_mass_sum_rises_towards_appendage_mass() {
         prev = frac;
     }
     // Rotations converge fastest; translations are limited by the axial (rod) fields.
-    assert!(prev.iter().all(|f| *f > 0.97), "{prev:?}");
+    assert!(prev.iter().all(|f| *f > 0.995), "{prev:?}");
 }
 
 #[test]

@@ -51,7 +51,12 @@ fn mutate(src: &str, kind: u8, line: usize, pick: usize, ch: char) -> String {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 512,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(43),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
     #[test]
     fn mutated_examples_never_panic(
         which in 0usize..2,
@@ -70,8 +75,11 @@ proptest! {
                 let model = RitzModel::assemble(&s.structure);
                 // Bound the work: a mutation may ask for 100×100 plate terms.
                 if model.dof() <= 600 {
-                    if let Ok(m) = ModalAnalysis::compute(&model) {
-                        prop_assert!(m.modes.iter().all(|x| x.omega_rad_s.is_finite()));
+                    match ModalAnalysis::compute(&model) {
+                        Ok(m) => {
+                            prop_assert!(m.modes.iter().all(|x| x.omega_rad_s.is_finite()));
+                        }
+                        Err(e) => prop_assert!(false, "accepted but not solved: {e}\n{src}"),
                     }
                 }
             }

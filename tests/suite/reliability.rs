@@ -404,19 +404,23 @@ fn the_next_run_removes_a_killed_runs_staging() {
     // A kill between moving the previous output aside (`.out.old-HOST-PID`) and moving the new
     // one in: the next run puts the previous output back (and, not forced, refuses to replace
     // it); forced, it replaces it and the backup is gone.
-    let dead = staging
-        .file_name()
-        .unwrap()
-        .to_str()
-        .unwrap()
-        .replacen(".out.partial-", ".out.old-", 1);
+    let dead =
+        staging
+            .file_name()
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .replacen(".out.partial-", ".out.old-", 1);
     std::fs::remove_dir_all(&out).unwrap();
     let backup = dir.join(&dead);
     std::fs::create_dir(&backup).unwrap();
     std::fs::write(backup.join("previous.txt"), "the previous output").unwrap();
     let again = |force: bool| {
         let mut c = bin();
-        c.arg("deploy").arg(example("seed.toml")).arg("--out").arg(&out);
+        c.arg("deploy")
+            .arg(example("seed.toml"))
+            .arg("--out")
+            .arg(&out);
         if force {
             c.arg("--force");
         }
