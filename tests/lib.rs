@@ -23,6 +23,7 @@ mod suite {
     pub mod deploy_maximal;
     pub mod exact_beams;
     pub mod export;
+    pub mod flex42_numpy;
     pub mod hardening_input;
     pub mod hardening_output;
     pub mod hinge_closed_forms;

@@ -466,7 +466,7 @@ const STALLED_CHANGE: f64 = 1e-11;
 ///   1e-8 of ‖K x‖ + |λ| ‖M x‖ (the eigenvalue's error is quadratic in it; the high-order
 ///   polynomial bases' conditioning leaves a rounding floor near 1e-11 on small models, up
 ///   to 1e-7 at hundreds of modes: once every λ has stayed settled for
-///   [`STALLED_ITERATIONS`], a residual up to [`FLOOR_RESIDUAL`] is accepted).
+///   three iterations, a residual up to 1e-6 is accepted).
 ///
 /// Falls back on the dense [`generalized_symmetric`] when p would not be smaller than n or n
 /// is at most [`DENSE_BELOW`].
