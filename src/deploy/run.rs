@@ -419,7 +419,10 @@ impl Stepper {
                 restorer: Restorer::default(),
                 rule: s.schedule,
                 omega: 0.0,
-                longest: LONGEST_STEP * s.end_time,
+                // The cap is refined with the steps (κ shrinks at each refinement level):
+                // a cap fixed across levels would set the quiet phases' steps alike in every
+                // run, and the accuracy estimate would not see their error.
+                longest: LONGEST_STEP * s.end_time * s.schedule.kappa / Schedule::default().kappa,
                 rubbing: Vec::new(),
                 energy_scale: 0.0,
                 energy_gained: 0,
@@ -1196,7 +1199,8 @@ impl<'a, E: Engine> Run<'a, E> {
     }
 }
 
-/// The scheduled stepper's longest step, as a fraction of the end time.
+/// The scheduled stepper's longest step, as a fraction of the end time, at the first
+/// refinement level (κ = 1; it shrinks with κ).
 const LONGEST_STEP: f64 = 0.01;
 
 /// The most points [`load_times`] gives one step (past it the step is not resolved).

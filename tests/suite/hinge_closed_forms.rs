@@ -342,6 +342,40 @@ fn viscous_hinge_auto_matches_the_damped_oscillator_to_its_reported_accuracy() {
     }
 }
 
+/// The automatic run's accuracy estimate sees every step it makes: a small swing (0.01 rad)
+/// asked to 1e-8, where the steps of the quiet free swing are set by the longest-step cap
+/// alone. Before the cap was refined with the steps, both runs made the same steps: the
+/// estimate was exactly 0, "reached", and the final rate was off by 1.9e-7 of itself. Now
+/// either the run says it did not reach 1e-8, or the closed form confirms it did (final angle
+/// and rate to the accuracy asked); and the estimate is never the zero of two identical runs.
+#[test]
+fn the_automatic_estimate_sees_the_capped_steps() {
+    let (p, mut h) = viscous_panel();
+    h.initial = h.reference - 0.01;
+    let end = 20.0;
+    let r = run(&scenario(p, h, end, 50.0, "accuracy = 1e-8"));
+    let acc = r
+        .accuracy
+        .clone()
+        .expect("the automatic integrator's accuracy");
+    assert!(acc.estimate > 0.0, "{acc:?}");
+    let j = p.inertia_about_hinge();
+    let osc = Damped::new(h.stiffness, h.damping, j, h.initial - h.reference);
+    let last = r.samples.last().unwrap();
+    let (xa, xd) = osc.at(last.t);
+    let (ea, er) = (last.alpha[0] - h.reference - xa, last.rate[0] - xd);
+    if acc.reached() {
+        assert!(
+            ea.abs() <= 1e-8 * h.latch,
+            "final angle off by {ea:e} ({acc:?})"
+        );
+        assert!(
+            er.abs() <= 1e-8 * xd.abs(),
+            "final rate off by {er:e} of {xd} ({acc:?})"
+        );
+    }
+}
+
 /// The Coulomb-damped oscillator J ẍ + k x + f sgn(ẋ) = 0, x = α − α_ref, released from rest
 /// at x₀ with |k x₀| > f. Between stops the motion is a half cycle of the undamped oscillator
 /// about the shifted centre x_c = sgn(x_n) f/k (opposite to the motion's sign): from the stop
