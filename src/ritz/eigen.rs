@@ -365,22 +365,22 @@ fn m_orthonormalize(m: &Operator, y: &mut Mat<f64>) -> Mat<f64> {
         let g = y.transpose() * &my;
         let p = g.nrows();
         let g = Mat::from_fn(p, p, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
-        let before = (y.clone(), my.clone());
         match g.llt(Side::Lower) {
             Ok(llt) => {
                 // Y L⁻ᵀ = (L⁻¹ Yᵀ)ᵀ.
-                for a in [&mut *y, &mut my] {
+                let apply = |a: &Mat<f64>| {
                     let mut t = a.transpose().to_owned();
                     llt.L().solve_lower_triangular_in_place(t.as_mut());
-                    *a = t.transpose().to_owned();
-                }
+                    t.transpose().to_owned()
+                };
+                let (ny, nmy) = (apply(y), apply(&my));
                 // A factor whose pivots underflowed (G singular but for rounding) leaves
-                // non-finite columns: Gram–Schmidt from the block before instead.
-                if !all_finite(y) || !all_finite(&my) {
-                    (*y, my) = before;
+                // non-finite columns: Gram–Schmidt on the block as it was instead.
+                if !all_finite(&ny) || !all_finite(&nmy) {
                     gram_schmidt(y, &mut my);
                     break;
                 }
+                (*y, my) = (ny, nmy);
             }
             Err(_) => {
                 gram_schmidt(y, &mut my);
