@@ -22,6 +22,7 @@ mod suite {
     pub mod deploy;
     pub mod deploy_maximal;
     pub mod exact_beams;
+    pub mod exact_peaks;
     pub mod export;
     pub mod flex42_numpy;
     pub mod hardening_input;

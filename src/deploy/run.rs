@@ -563,6 +563,9 @@ struct Run<'a, E: Engine> {
     /// interpolate between them; false where the adiabatic stepper's ringing turns by more
     /// than [`LOAD_PHASE`] between them (a parabola through such points is no peak).
     resolved: bool,
+    /// The latest two steps' dense outputs (the older first), from which the peak trackers'
+    /// candidates are evaluated ([`PeakTracker::resolve`]).
+    dense: [Option<DenseStep>; 2],
 }
 
 impl<'a, E: Engine> Run<'a, E> {
@@ -600,6 +603,7 @@ impl<'a, E: Engine> Run<'a, E> {
             latch_up_peaks: PeakTracker::default(),
             latch_up: None,
             resolved: true,
+            dense: [None, None],
         }
         .with_phase()
     }
@@ -848,6 +852,8 @@ impl<'a, E: Engine> Run<'a, E> {
             self.t = step.t0;
             return false;
         }
+        self.dense.swap(0, 1);
+        self.dense[1] = Some(step.clone());
         let open = self.sys.open();
         let event = events::earliest_latch(&step, off, &self.latch_angles, &open).map(|e| {
             // An ideal cable brings every hinge to its latch angle at the same instant (up to
@@ -943,6 +949,34 @@ impl<'a, E: Engine> Run<'a, E> {
         if self.last_event.is_finite() {
             self.latch_up_peaks.observe(t, m);
         }
+        self.resolve_peaks();
+    }
+
+    /// Evaluates the peak trackers' candidates from the latest steps' dense outputs, with
+    /// the hinges' current states (the trackers' brackets never span an event).
+    fn resolve_peaks(&mut self) {
+        if !self.peaks.has_pending() && !self.latch_up_peaks.has_pending() {
+            return;
+        }
+        let (steps, sys) = (&self.dense, &self.sys);
+        let mut buf = vec![0.0; self.y.len()];
+        let mut cache: Vec<(f64, Vec<f64>)> = Vec::new();
+        let mut eval = |t: f64| -> Option<Vec<f64>> {
+            if let Some((_, m)) = cache.iter().find(|(s, _)| *s == t) {
+                return Some(m.clone());
+            }
+            let step = steps
+                .iter()
+                .rev()
+                .flatten()
+                .find(|d| t >= d.t0 && t <= d.t0 + d.h)?;
+            step.eval(t, &mut buf);
+            let m = sys.engine.load_magnitudes(&buf, &sys.free, &sys.captured);
+            cache.push((t, m.clone()));
+            Some(m)
+        };
+        self.peaks.resolve(&mut eval);
+        self.latch_up_peaks.resolve(&mut eval);
     }
 
     /// How long after an impact or a capture the tracked loads are also observed inside the
@@ -965,11 +999,16 @@ impl<'a, E: Engine> Run<'a, E> {
     fn sample_until(&mut self, step: &DenseStep, t_limit: f64) {
         let r = self.alpha_range();
         let fastest = step.fastest_ringing();
-        let inner = if fastest > 0.0 && step.t0 < self.last_event + self.latch_up_window(step) {
+        let mut inner = if fastest > 0.0 && step.t0 < self.last_event + self.latch_up_window(step) {
             load_times(fastest, step.t0, t_limit)
         } else {
             Vec::new()
         };
+        if inner.is_empty() && t_limit > step.t0 {
+            // The step's midpoint: with its ends, three points of every step, so that a
+            // peak inside a step shows as a rise and fall and is resolved there.
+            inner.push(0.5 * (step.t0 + t_limit));
+        }
         if !self.resolved {
             // No parabola spans the unresolved step before this one.
             self.peaks.break_history();
@@ -1004,11 +1043,8 @@ impl<'a, E: Engine> Run<'a, E> {
                 s.restorer.clone().restore(&self.sys, &mut self.buf, false);
             }
             self.swing.observe(tk, &self.buf[r.clone()]);
-            let m = self
-                .sys
-                .engine
-                .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
-            self.observe(tk, &m);
+            // The load peaks are not observed at the samples: they come from the steps
+            // (and the points inside them), so that they do not move with the output rate.
             if self.s.record_samples {
                 self.samples.push(self.sys.engine.sample(
                     tk,

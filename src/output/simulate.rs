@@ -79,17 +79,12 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
     })
 }
 
-/// The largest magnitude over the response's samples of the vector made of channels `cs`
-/// (one channel: its absolute value), with its time from release.
-fn response_peak(r: &Response, cs: &[usize]) -> Peak {
-    let h = &r.history;
-    let t0 = r.handover.latch_time;
-    (0..h.times.len())
-        .map(|k| {
-            let v = cs.iter().map(|&c| h.values[(k, c)].powi(2)).sum::<f64>();
-            (v.sqrt(), t0 + h.times[k])
-        })
-        .fold((0.0, 0.0), |a, x| if x.0 > a.0 { x } else { a })
+/// The largest magnitude over the response of the vector made of channels `cs` (a beam
+/// root's force or moment; one channel: its absolute value), from the closed form, with its
+/// time from release.
+fn response_peak(r: &Response, cs: &[usize]) -> Option<Peak> {
+    let (v, t) = r.history.vector_peak(cs)?;
+    Some((v, r.handover.latch_time + t))
 }
 
 fn peak_json(p: Option<Peak>) -> Value {
@@ -127,7 +122,7 @@ fn peak_loads(sim: &Simulation) -> Value {
         .map(|(beam, f, m)| {
             let cs = find(&|k| matches!(k, ChannelKind::BeamRoot { beam: b } if *b == beam));
             let (rf, rm) = match (r, cs.len()) {
-                (Some(r), 6) => (Some(response_peak(r, &cs[..3])), Some(response_peak(r, &cs[3..]))),
+                (Some(r), 6) => (response_peak(r, &cs[..3]), response_peak(r, &cs[3..])),
                 _ => (None, None),
             };
             json!({
@@ -144,7 +139,7 @@ fn peak_loads(sim: &Simulation) -> Value {
             let d = dep_latch.get(i).copied();
             let cs = find(&|k| matches!(k, ChannelKind::LatchMoment { hinge } if *hinge == i + 1));
             let rp = match (r, cs.as_slice()) {
-                (Some(r), [c]) => Some(response_peak(r, &[*c])),
+                (Some(r), [c]) => response_peak(r, &[*c]),
                 _ => None,
             };
             json!({"hinge": i + 1, "deployment": peak_json(d), "response": peak_json(rp), "overall": overall(d, rp)})

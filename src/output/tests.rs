@@ -260,10 +260,11 @@ fn long_series_are_decimated_for_plots_but_not_for_csv() {
             assert!(x.len() <= crate::output::figures::PLOT_POINTS && x.len() == y.len());
             let xs: Vec<f64> = x.iter().map(|v| v.as_f64().unwrap()).collect();
             assert!(xs.windows(2).all(|w| w[0] <= w[1]), "x not monotone");
-            // A response channel's peak |value| (summary.json) is in the plotted data.
+            // A response channel's largest sampled |value| is in the plotted data (the
+            // closed-form peak of summary.json may lie between samples).
             let name = sr["name"].as_str().unwrap();
             if let Some(c) = r.channels.iter().position(|c| c.label == name) {
-                let peak = r.history.peak(c).0;
+                let peak = r.history.sampled_peak(c).0;
                 let drawn = y
                     .iter()
                     .map(|v| v.as_f64().unwrap().abs())

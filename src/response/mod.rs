@@ -5,6 +5,7 @@
 //! included ([`loads`]).
 
 pub mod channels;
+pub mod extrema;
 pub mod handover;
 pub mod loads;
 pub mod superposition;

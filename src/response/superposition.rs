@@ -10,7 +10,8 @@
 //! No time stepping: an undamped mode keeps its energy ½(η̇² + ω²η²) to rounding for any
 //! duration, and the samples t_k = k/rate are exact.
 
-use super::channels::{Channel, Order};
+use super::channels::{Channel, ChannelKind, Order};
+use super::extrema::{self, PeakSearch, Scalar, SquaredNorm, Wave, WaveSum};
 use super::ResponseSettings;
 use crate::ritz::ModalAnalysis;
 use faer::Mat;
@@ -56,6 +57,12 @@ pub struct ResponseHistory {
     pub modal: Mat<f64>,
     /// Elastic energy Σ_elastic ½(η̇² + ω²η²) at every sample, J.
     pub elastic_energy: Vec<f64>,
+    /// Every channel's largest |value| on [0, duration] and its time, from the closed form
+    /// ([`ModalResponse::peaks`]), not from the samples.
+    pub peaks: Vec<(f64, f64)>,
+    /// Every beam root's force and moment (its three channels) with the largest magnitude of
+    /// the vector and its time, likewise.
+    pub vector_peaks: Vec<(Vec<usize>, (f64, f64))>,
 }
 
 impl ModalResponse {
@@ -128,24 +135,11 @@ impl ModalResponse {
         channels: &[Channel],
         settings: &ResponseSettings,
     ) -> ResponseHistory {
+        let groups = vector_groups(channels);
+        let (peaks, vector_peaks) = self.peaks(modal, channels, &groups, settings.duration);
         let rows = settings.rows() as usize;
         let nm = self.modes.len();
         let times: Vec<f64> = (0..rows).map(|k| k as f64 / settings.output_rate).collect();
-        // Channel gains G_jc = c · φ_j, split by the derivative each channel reads.
-        let gain = |order: Order| {
-            Mat::from_fn(nm, channels.len(), |j, c| {
-                if channels[c].order != order {
-                    return 0.0;
-                }
-                let shape = &modal.modes[self.modes[j].number - 1].shape;
-                channels[c]
-                    .row
-                    .iter()
-                    .zip(shape)
-                    .map(|(a, b)| a * b)
-                    .sum::<f64>()
-            })
-        };
         let mut eta = Mat::<f64>::zeros(rows, nm);
         let mut eta_dd = Mat::<f64>::zeros(rows, nm);
         let mut energy = vec![0.0; rows];
@@ -162,9 +156,9 @@ impl ModalResponse {
                 eta_dd[(k, j)] = *a;
             }
         }
-        let mut values = &eta * gain(Order::Displacement);
+        let mut values = &eta * self.gains(modal, channels, Order::Displacement);
         if channels.iter().any(|c| c.order == Order::Acceleration) {
-            values += &eta_dd * gain(Order::Acceleration);
+            values += &eta_dd * self.gains(modal, channels, Order::Acceleration);
         }
         for (c, ch) in channels.iter().enumerate() {
             if ch.offset != 0.0 {
@@ -178,16 +172,243 @@ impl ModalResponse {
             values,
             modal: eta,
             elastic_energy: energy,
+            peaks,
+            vector_peaks: groups.into_iter().zip(vector_peaks).collect(),
         }
     }
 }
 
+impl ModalResponse {
+    /// The channel gains G_jc = c · φ_j of the channels reading `order` (0 for the others),
+    /// kept modes × channels.
+    fn gains(&self, modal: &ModalAnalysis, channels: &[Channel], order: Order) -> Mat<f64> {
+        Mat::from_fn(self.modes.len(), channels.len(), |j, c| {
+            if channels[c].order != order {
+                return 0.0;
+            }
+            let shape = &modal.modes[self.modes[j].number - 1].shape;
+            channels[c]
+                .row
+                .iter()
+                .zip(shape)
+                .map(|(a, b)| a * b)
+                .sum::<f64>()
+        })
+    }
+
+    /// Kept mode j's η(t) as a wave sum: η₀ + η̇₀t for a rigid mode, otherwise
+    /// e^{−ζωt}(η₀ cos ω_d t + (η̇₀ + ζωη₀)/ω_d · sin ω_d t).
+    fn mode_signal(&self, j: usize) -> WaveSum {
+        let m = &self.modes[j];
+        if m.rigid || m.omega_rad_s == 0.0 {
+            return WaveSum {
+                constant: m.eta0,
+                slope: m.eta_dot0,
+                waves: Vec::new(),
+            };
+        }
+        let (w, z) = (m.omega_rad_s, self.damping_ratio);
+        let wd = w * (1.0 - z * z).sqrt();
+        WaveSum {
+            constant: 0.0,
+            slope: 0.0,
+            waves: vec![Wave {
+                sigma: z * w,
+                omega: wd,
+                p: m.eta0,
+                q: (m.eta_dot0 + z * w * m.eta0) / wd,
+            }],
+        }
+    }
+
+    /// Every channel as a sum of damped sinusoids, its value in closed form at any time:
+    /// offset + Σ_j (G_jc η_j or G_jc η̈_j).
+    pub fn signals(&self, modal: &ModalAnalysis, channels: &[Channel]) -> Vec<WaveSum> {
+        let (gd, ga) = (
+            self.gains(modal, channels, Order::Displacement),
+            self.gains(modal, channels, Order::Acceleration),
+        );
+        let modes: Vec<WaveSum> = (0..self.modes.len()).map(|j| self.mode_signal(j)).collect();
+        (0..channels.len())
+            .map(|c| {
+                let mut s = WaveSum {
+                    constant: channels[c].offset,
+                    ..WaveSum::default()
+                };
+                for (j, m) in modes.iter().enumerate() {
+                    let (d, a) = (gd[(j, c)], ga[(j, c)]);
+                    s.constant += d * m.constant;
+                    s.slope += d * m.slope;
+                    for w in &m.waves {
+                        let acc = w.derivative().derivative();
+                        s.waves.push(Wave {
+                            p: d * w.p + a * acc.p,
+                            q: d * w.q + a * acc.q,
+                            ..*w
+                        });
+                    }
+                }
+                s
+            })
+            .collect()
+    }
+
+    /// The largest |value| of every channel on [0, duration] and its time, and the largest
+    /// magnitude √(Σ v_c²) of every group of channels (a force's or a moment's components),
+    /// exact to [`extrema::TOLERANCE`] of the channel's scale at any output rate
+    /// ([`extrema`]): the first pass evaluates every mode on one grid of spacing
+    /// π / (4 ω_max) and the channels from them in bulk, as the samples are.
+    pub fn peaks(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+        groups: &[Vec<usize>],
+        duration: f64,
+    ) -> (Vec<Peak>, Vec<Peak>) {
+        let signals = self.signals(modal, channels);
+        let mut norms: Vec<PeakSearch<SquaredNorm>> = groups
+            .iter()
+            .map(|g| {
+                let parts: Vec<&WaveSum> = g.iter().map(|&c| &signals[c]).collect();
+                PeakSearch::new(SquaredNorm::new(&parts, duration.max(0.0)))
+            })
+            .collect();
+        let fastest = signals.iter().map(WaveSum::fastest).fold(0.0, f64::max);
+        let grid = extrema::grid(fastest, duration.max(0.0));
+        let mut searches: Vec<PeakSearch<Scalar>> = signals
+            .iter()
+            .map(|s| PeakSearch::new(Scalar::new(s, duration.max(0.0))))
+            .collect();
+        let (gd, ga) = (
+            self.gains(modal, channels, Order::Displacement),
+            self.gains(modal, channels, Order::Acceleration),
+        );
+        let nm = self.modes.len();
+        let zeta = self.damping_ratio;
+        // The grid is uniform: t_i = i·h.
+        let h = if grid.len() > 1 { grid[1] } else { 0.0 };
+        let chunk = PEAK_CHUNK.min(grid.len());
+        let (mut e, mut ed, mut edd, mut eddd) = (
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+        );
+        let mut values = Mat::<f64>::zeros(chunk, channels.len());
+        let mut slopes = Mat::<f64>::zeros(chunk, channels.len());
+        let mut knots = Vec::with_capacity(chunk);
+        let mut start = 0;
+        loop {
+            // Pieces share their end knots.
+            let end = (start + chunk - 1).min(grid.len() - 1);
+            let rows = end - start + 1;
+            // η, η̇, η̈ = −2ζωη̇ − ω²η and η⃛ = −2ζωη̈ − ω²η̇ of every mode at the piece's times.
+            for (j, m) in self.modes.iter().enumerate() {
+                let w = if m.rigid { 0.0 } else { m.omega_rad_s };
+                let (x, xd) = (
+                    e.col_mut(j)
+                        .try_as_col_major_mut()
+                        .expect("column-major")
+                        .as_slice_mut(),
+                    ed.col_mut(j)
+                        .try_as_col_major_mut()
+                        .expect("column-major")
+                        .as_slice_mut(),
+                );
+                fill_state(m, zeta, grid[start], h, &mut x[..rows], &mut xd[..rows]);
+                for i in 0..rows {
+                    let (x, xd) = (e[(i, j)], ed[(i, j)]);
+                    let xdd = -2.0 * zeta * w * xd - w * w * x;
+                    edd[(i, j)] = xdd;
+                    eddd[(i, j)] = -2.0 * zeta * w * xdd - w * w * xd;
+                }
+            }
+            let (er, edr, eddr, edddr) = (
+                e.subrows(0, rows),
+                ed.subrows(0, rows),
+                edd.subrows(0, rows),
+                eddd.subrows(0, rows),
+            );
+            let mut v = values.subrows_mut(0, rows);
+            v.copy_from(er * &gd + eddr * &ga);
+            let mut d = slopes.subrows_mut(0, rows);
+            d.copy_from(edr * &gd + edddr * &ga);
+            for (c, search) in searches.iter_mut().enumerate() {
+                knots.clear();
+                knots.extend((0..rows).map(|i| {
+                    (
+                        grid[start + i],
+                        values[(i, c)] + channels[c].offset,
+                        slopes[(i, c)],
+                    )
+                }));
+                search.feed(&knots);
+            }
+            for (group, search) in groups.iter().zip(&mut norms) {
+                knots.clear();
+                knots.extend((0..rows).map(|i| {
+                    group
+                        .iter()
+                        .fold((grid[start + i], 0.0, 0.0), |(t, g, dg), &c| {
+                            let v = values[(i, c)] + channels[c].offset;
+                            (t, g + v * v, dg + 2.0 * v * slopes[(i, c)])
+                        })
+                }));
+                search.feed(&knots);
+            }
+            if end + 1 >= grid.len() {
+                break;
+            }
+            start = end;
+        }
+        (
+            searches.into_iter().map(PeakSearch::finish).collect(),
+            norms
+                .into_iter()
+                .map(|s| {
+                    let (g, t) = s.finish();
+                    (g.sqrt(), t)
+                })
+                .collect(),
+        )
+    }
+}
+
+/// The channel groups whose magnitude is a load: each beam root's force and moment, the
+/// first and last three of its six channels ([`super::loads`]).
+fn vector_groups(channels: &[Channel]) -> Vec<Vec<usize>> {
+    let mut beams: Vec<&str> = Vec::new();
+    for c in channels {
+        if let ChannelKind::BeamRoot { beam } = &c.kind {
+            if !beams.contains(&beam.as_str()) {
+                beams.push(beam);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for beam in beams {
+        let cs: Vec<usize> = channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| matches!(&c.kind, ChannelKind::BeamRoot { beam: b } if b == beam))
+            .map(|(i, _)| i)
+            .collect();
+        if cs.len() == 6 {
+            out.push(cs[..3].to_vec());
+            out.push(cs[3..].to_vec());
+        }
+    }
+    out
+}
+
+/// A peak |value| and its time (s after the hand-over).
+pub type Peak = (f64, f64);
+
+/// Grid intervals evaluated together in [`ModalResponse::peaks`].
+const PEAK_CHUNK: usize = 2048;
+
 /// Samples at t_k = k·h of one mode into `eta` and its acceleration
 /// η̈ = −2ζωη̇ − ω²η into `eta_dd`, adding its energy to `energy` (elastic modes).
-/// Within blocks of [`RESYNC`] samples the phase advances by the rotation
-/// (cos, sin)(θ + ω_d h) = (c cos ω_d h − s sin ω_d h, s cos ω_d h + c sin ω_d h) and the decay
-/// by the factor e^{−ζωh}; each block starts from the closed form at t = k·h, so rounding
-/// cannot accumulate beyond RESYNC steps (≈ 1e-14 relative).
 fn fill_mode(
     m: &KeptMode,
     zeta: f64,
@@ -196,11 +417,31 @@ fn fill_mode(
     eta_dd: &mut [f64],
     energy: &mut [f64],
 ) {
+    let mut eta_dot = vec![0.0; eta.len()];
+    fill_state(m, zeta, 0.0, h, eta, &mut eta_dot);
     if m.rigid || m.omega_rad_s == 0.0 {
-        for (k, e) in eta.iter_mut().enumerate() {
-            *e = m.eta0 + m.eta_dot0 * (k as f64 * h);
-        }
         eta_dd.fill(0.0);
+        return;
+    }
+    let w = m.omega_rad_s;
+    for k in 0..eta.len() {
+        let (e, ed) = (eta[k], eta_dot[k]);
+        eta_dd[k] = -2.0 * zeta * w * ed - w * w * e;
+        energy[k] += 0.5 * (ed * ed + w * w * e * e);
+    }
+}
+
+/// η and η̇ of one mode at t_k = t₀ + k·h. Within blocks of [`RESYNC`] samples the phase
+/// advances by the rotation (cos, sin)(θ + ω_d h) = (c cos ω_d h − s sin ω_d h,
+/// s cos ω_d h + c sin ω_d h) and the decay by the factor e^{−ζωh}; each block starts from the
+/// closed form at its own time, so rounding cannot accumulate beyond RESYNC steps (≈ 1e-14
+/// relative).
+fn fill_state(m: &KeptMode, zeta: f64, t0: f64, h: f64, eta: &mut [f64], eta_dot: &mut [f64]) {
+    if m.rigid || m.omega_rad_s == 0.0 {
+        for (k, (e, ed)) in eta.iter_mut().zip(eta_dot.iter_mut()).enumerate() {
+            *e = m.eta0 + m.eta_dot0 * (t0 + k as f64 * h);
+            *ed = m.eta_dot0;
+        }
         return;
     }
     let w = m.omega_rad_s;
@@ -209,23 +450,21 @@ fn fill_mode(
     let (sd, cd) = (wd * h).sin_cos();
     let step_decay = (-zeta * w * h).exp();
     for k0 in (0..eta.len()).step_by(RESYNC) {
-        let t0 = k0 as f64 * h;
-        let (mut s, mut c) = (wd * t0).sin_cos();
-        let mut decay = (-zeta * w * t0).exp();
+        let tb = t0 + k0 as f64 * h;
+        let (mut s, mut c) = (wd * tb).sin_cos();
+        let mut decay = (-zeta * w * tb).exp();
         let end = (k0 + RESYNC).min(eta.len());
         for k in k0..end {
             let e = decay * (a * c + b * s);
-            let ed = -zeta * w * e + decay * wd * (b * c - a * s);
             eta[k] = e;
-            eta_dd[k] = -2.0 * zeta * w * ed - w * w * e;
-            energy[k] += 0.5 * (ed * ed + w * w * e * e);
+            eta_dot[k] = -zeta * w * e + decay * wd * (b * c - a * s);
             (s, c) = (s * cd + c * sd, c * cd - s * sd);
             decay *= step_decay;
         }
     }
 }
 
-/// Samples between two closed-form evaluations in [`fill_mode`].
+/// Samples between two closed-form evaluations in [`fill_state`].
 const RESYNC: usize = 32;
 
 fn state(m: &KeptMode, zeta: f64, t: f64) -> (f64, f64) {
@@ -256,8 +495,15 @@ impl ResponseHistory {
             .fold(0.0, f64::max)
     }
 
-    /// Largest |value| of channel c and the time it occurs.
+    /// Largest |value| of channel c on [0, duration] and the time it occurs, from the
+    /// closed form (not from the samples: [`ModalResponse::peaks`]).
     pub fn peak(&self, c: usize) -> (f64, f64) {
+        self.peaks[c]
+    }
+
+    /// Largest |value| of channel c among the samples, and its time (what a plot of the
+    /// samples shows; never above [`Self::peak`]).
+    pub fn sampled_peak(&self, c: usize) -> (f64, f64) {
         let mut best = (0.0, 0.0);
         for (k, &t) in self.times.iter().enumerate() {
             let v = self.values[(k, c)];
@@ -266,6 +512,19 @@ impl ResponseHistory {
             }
         }
         best
+    }
+
+    /// The largest magnitude of the vector of channels `cs` (a beam root's force or moment:
+    /// [`Self::vector_peaks`]; one channel: [`Self::peak`]), None for another group.
+    pub fn vector_peak(&self, cs: &[usize]) -> Option<(f64, f64)> {
+        match cs {
+            [c] => self.peaks.get(*c).copied(),
+            _ => self
+                .vector_peaks
+                .iter()
+                .find(|(g, _)| g.as_slice() == cs)
+                .map(|(_, p)| *p),
+        }
     }
 
     /// The value of channel c at the last sample.

@@ -71,12 +71,14 @@ fn seed_with_the_ideal_cable_matches_the_explicit_reference_in_few_steps() {
     let d = latch_differences(&adiabatic, &reference);
     assert!(d[0] <= 2e-9, "latch time {d:?}");
     assert!(d[1] <= 3e-7 && d[2] <= 3e-7 && d[3] <= 3e-7, "{d:?}");
-    // Before the latch the adiabatic run reads the loads at its step ends only, which do not
+    // Before the latch the adiabatic run reads the loads at its step ends and midpoints only
+    // (not at the output samples, so that no peak moves with the output rate), which do not
     // resolve the ringing: its peaks may come out low, never high (a parabola through such
     // points put 11.2 N at the mast root against the resolved 7.96 N), and low by at most the
-    // ringing's share documented in docs/scenario.md (4 % on the mast root moment: 3.8 %
-    // measured); a peak at the latch itself is the impact's, computed alike (to 1e-6); a load
-    // that vanishes in the reference (the rigid latches' moments) vanishes too.
+    // ringing's share documented in docs/scenario.md (11 % on the mast root moment: 10.5 %
+    // measured; 3.8 % when the 10 Hz samples were read too); a peak at the latch itself is
+    // the impact's, computed alike (to 1e-6); a load that vanishes in the reference (the rigid
+    // latches' moments) vanishes too.
     let latch = reference.latches[0].time;
     for (p, q) in adiabatic.load_peaks.iter().zip(&reference.load_peaks) {
         let what = format!("peak {} at {} s, reference {} at {} s", p.0, p.1, q.0, q.1);
@@ -85,7 +87,7 @@ fn seed_with_the_ideal_cable_matches_the_explicit_reference_in_few_steps() {
         } else if q.1 >= latch {
             assert!((p.0 - q.0).abs() <= 1e-6 * q.0, "{what}");
         } else {
-            assert!(p.0 <= q.0 * (1.0 + 1e-6) && p.0 >= 0.95 * q.0, "{what}");
+            assert!(p.0 <= q.0 * (1.0 + 1e-6) && p.0 >= 0.89 * q.0, "{what}");
         }
     }
     assert!(

@@ -540,10 +540,12 @@ fn simulate_writes_complete_reproducible_outputs() {
         .iter()
         .find(|c| c["name"] == "wing_tip_plus")
         .unwrap();
-    // serde_json's default float parser may be 1 ulp off the shortest representation.
+    // The summary's peak is the closed form's (docs/theory.md §3.2): no sample is above it
+    // (serde_json's default float parser may be 1 ulp off), and the 50 Hz samples of the
+    // wing's ~1 Hz bending come within 1e-3 of it.
     let want = ch["peak"].as_f64().unwrap();
     assert!(
-        (peak - want).abs() <= 4.0 * f64::EPSILON * want,
+        peak <= want * (1.0 + 4.0 * f64::EPSILON) && peak >= want * (1.0 - 1e-3),
         "{peak} vs {want}"
     );
     // --json prints the same object as summary.json.

@@ -1,0 +1,474 @@
+//! The largest |v(t)| over an interval of a sum of damped sinusoids, exactly (to a relative
+//! 1e-10 of the signal's scale), not read from samples (docs/theory.md §3.2).
+//!
+//! A channel of the modal superposition is
+//!
+//!   v(t) = c₀ + c₁ t + Σ_k e^{−σ_k t} (p_k cos ω_k t + q_k sin ω_k t),
+//!
+//! the rigid modes giving the polynomial part and every elastic mode one wave. Its peak is
+//! found by branch and bound on a grid of spacing h₀ = π / (4 ω_max):
+//!
+//! * on every interval [t₀, t₁] the cubic Hermite interpolant H of v and v′ at the ends
+//!   differs from v by at most M₄ h⁴ / 384 (M₄ ≥ |v⁗| on the interval: the interpolation
+//!   error (t − t₀)²(t − t₁)² v⁗(ξ)/4!), and its own largest |H| is found from the roots of
+//!   the quadratic H′;
+//! * an interval whose largest |H| plus that bound cannot beat the best value found is
+//!   dropped; the others are halved (v and v′ evaluated in closed form at the midpoint),
+//!   which divides the bound by 16, until it is below the tolerance, and v is then evaluated
+//!   at the interpolant's maximiser.
+//!
+//! The result is a value v attains (never an overestimate) within the tolerance of the true
+//! maximum, at any sampling of the output. Each wave's derivatives are waves again: with
+//! λ = −σ + iω, v = Re(C e^{λt}), C = p − iq, so v⁽ⁿ⁾ = Re(C λⁿ e^{λt}) and
+//! |v⁽ⁿ⁾(t)| ≤ |C| |λ|ⁿ e^{−σt}.
+//!
+//! Hand-written: no crate finds the global extremum of an exponential-trigonometric sum.
+
+/// One damped sinusoid e^{−σt}(p cos ωt + q sin ωt).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Wave {
+    /// Decay rate σ ≥ 0, 1/s.
+    pub sigma: f64,
+    /// Angular frequency ω > 0, rad/s.
+    pub omega: f64,
+    /// Cosine amplitude at t = 0.
+    pub p: f64,
+    /// Sine amplitude at t = 0.
+    pub q: f64,
+}
+
+impl Wave {
+    /// Its time derivative: e^{−σt}((ωq − σp) cos ωt − (σq + ωp) sin ωt).
+    pub fn derivative(&self) -> Self {
+        Self {
+            p: self.omega * self.q - self.sigma * self.p,
+            q: -(self.sigma * self.q + self.omega * self.p),
+            ..*self
+        }
+    }
+
+    /// Value at t.
+    pub fn at(&self, t: f64) -> f64 {
+        let (s, c) = (self.omega * t).sin_cos();
+        (-self.sigma * t).exp() * (self.p * c + self.q * s)
+    }
+
+    /// |C| = √(p² + q²): |v(t)| ≤ |C| e^{−σt}.
+    pub fn modulus(&self) -> f64 {
+        self.p.hypot(self.q)
+    }
+
+    /// |λ| = √(σ² + ω²): each derivative multiplies the modulus by it.
+    pub fn rate(&self) -> f64 {
+        self.sigma.hypot(self.omega)
+    }
+}
+
+/// v(t) = c₀ + c₁ t + Σ waves.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct WaveSum {
+    /// c₀.
+    pub constant: f64,
+    /// c₁, per second.
+    pub slope: f64,
+    /// The waves.
+    pub waves: Vec<Wave>,
+}
+
+impl WaveSum {
+    /// v(t).
+    pub fn at(&self, t: f64) -> f64 {
+        self.constant + self.slope * t + self.waves.iter().map(|w| w.at(t)).sum::<f64>()
+    }
+
+    /// v′ as a sum of the same kind.
+    pub fn derivative(&self) -> Self {
+        Self {
+            constant: self.slope,
+            slope: 0.0,
+            waves: self.waves.iter().map(Wave::derivative).collect(),
+        }
+    }
+
+    /// A bound on |v⁽ⁿ⁾(t)| for every t ≥ t₀ (n ≥ 2: the polynomial part has none).
+    pub fn derivative_bound(&self, n: i32, t0: f64) -> f64 {
+        self.waves
+            .iter()
+            .map(|w| w.modulus() * w.rate().powi(n) * (-w.sigma * t0).exp())
+            .sum()
+    }
+
+    /// The scale of the signal: |c₀| + |c₁| t_end + Σ |C_k| (what "relative" refers to).
+    pub fn scale(&self, t_end: f64) -> f64 {
+        self.constant.abs()
+            + self.slope.abs() * t_end
+            + self.waves.iter().map(Wave::modulus).sum::<f64>()
+    }
+
+    /// The fastest wave's ω (0 without waves).
+    pub fn fastest(&self) -> f64 {
+        self.waves.iter().map(|w| w.rate()).fold(0.0, f64::max)
+    }
+}
+
+/// The relative tolerance of [`peak`], against [`WaveSum::scale`].
+pub const TOLERANCE: f64 = 1e-10;
+
+/// The grid spacing of the first pass, as a fraction of π / ω_max.
+pub const GRID_FRACTION: f64 = 0.25;
+
+/// The deepest halving of one grid interval (each divides the bound by 16).
+const MAX_DEPTH: usize = 24;
+
+/// A point of the signal: (t, v, v′).
+pub type Knot = (f64, f64, f64);
+
+/// The running maximum of |v| and where.
+#[derive(Debug, Clone, Copy)]
+struct Best {
+    value: f64,
+    time: f64,
+}
+
+impl Best {
+    fn offer(&mut self, t: f64, v: f64) {
+        if v.abs() > self.value {
+            self.value = v.abs();
+            self.time = t;
+        }
+    }
+}
+
+/// The largest |H| of the cubic Hermite interpolant through two knots, and where.
+pub fn hermite_max(a: Knot, b: Knot) -> (f64, f64) {
+    let h = b.0 - a.0;
+    let mut best = if a.1.abs() >= b.1.abs() {
+        (a.1.abs(), a.0)
+    } else {
+        (b.1.abs(), b.0)
+    };
+    if h <= 0.0 {
+        return best;
+    }
+    // H(s) = v₀ h₀₀ + h v₀′ h₁₀ + v₁ h₀₁ + h v₁′ h₁₁ on s ∈ [0, 1]; as c₀ + c₁s + c₂s² + c₃s³.
+    let (v0, d0, v1, d1) = (a.1, a.2 * h, b.1, b.2 * h);
+    let c1 = d0;
+    let c2 = 3.0 * (v1 - v0) - 2.0 * d0 - d1;
+    let c3 = 2.0 * (v0 - v1) + d0 + d1;
+    let value = |s: f64| v0 + s * (c1 + s * (c2 + s * c3));
+    // H′(s) = c₁ + 2c₂ s + 3c₃ s².
+    let (roots, count) = quadratic_roots(3.0 * c3, 2.0 * c2, c1);
+    for &s in &roots[..count] {
+        if s > 0.0 && s < 1.0 {
+            let v = value(s).abs();
+            if v > best.0 {
+                best = (v, a.0 + s * h);
+            }
+        }
+    }
+    best
+}
+
+/// The real roots of a x² + b x + c (of the linear equation when a = 0; none when both
+/// vanish), computed without cancellation: the roots and how many there are.
+fn quadratic_roots(a: f64, b: f64, c: f64) -> ([f64; 2], usize) {
+    let scale = a.abs().max(b.abs()).max(c.abs());
+    if scale == 0.0 {
+        return ([0.0; 2], 0);
+    }
+    if a.abs() <= 1e-14 * scale {
+        return if b != 0.0 {
+            ([-c / b, 0.0], 1)
+        } else {
+            ([0.0; 2], 0)
+        };
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return ([0.0; 2], 0);
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    if q == 0.0 {
+        return ([0.0; 2], 1);
+    }
+    ([q / a, c / q], 2)
+}
+
+/// What a [`PeakSearch`] maximises the absolute value of: a signal in closed form, its
+/// value and slope at any time, and a bound on its fourth derivative.
+pub trait Objective {
+    /// (g(t), g′(t)).
+    fn at(&self, t: f64) -> (f64, f64);
+    /// A bound on |g⁗(t)| for every t in [t₀, t_end].
+    fn fourth_bound(&self, t0: f64) -> f64;
+    /// The scale the tolerance is relative to.
+    fn scale(&self) -> f64;
+}
+
+/// One channel: g = v, |g| its magnitude.
+#[derive(Debug, Clone)]
+pub struct Scalar<'a> {
+    v: &'a WaveSum,
+    dv: WaveSum,
+    t_end: f64,
+}
+
+impl<'a> Scalar<'a> {
+    /// The signal `v` on [0, t_end].
+    pub fn new(v: &'a WaveSum, t_end: f64) -> Self {
+        Self {
+            v,
+            dv: v.derivative(),
+            t_end,
+        }
+    }
+}
+
+impl Objective for Scalar<'_> {
+    fn at(&self, t: f64) -> (f64, f64) {
+        (self.v.at(t), self.dv.at(t))
+    }
+    fn fourth_bound(&self, t0: f64) -> f64 {
+        self.v.derivative_bound(4, t0)
+    }
+    fn scale(&self) -> f64 {
+        self.v.scale(self.t_end)
+    }
+}
+
+/// A vector of channels (a force's or a moment's components): g = Σ v_c², whose peak is
+/// the squared magnitude's. By Leibniz, g⁗ = Σ_c Σ_k C(4,k) v_c⁽ᵏ⁾ v_c⁽⁴⁻ᵏ⁾, bounded with
+/// |v⁽ᵏ⁾| ≤ B_k: B₀ = |c₀| + |c₁| t_end + Σ|C|e^{−σt₀}, B₁ = |c₁| + Σ|C||λ|e^{−σt₀},
+/// B_k = Σ|C||λ|ᵏe^{−σt₀}.
+#[derive(Debug, Clone)]
+pub struct SquaredNorm<'a> {
+    parts: Vec<Scalar<'a>>,
+}
+
+impl<'a> SquaredNorm<'a> {
+    /// The components `vs` on [0, t_end].
+    pub fn new(vs: &[&'a WaveSum], t_end: f64) -> Self {
+        Self {
+            parts: vs.iter().map(|v| Scalar::new(v, t_end)).collect(),
+        }
+    }
+}
+
+impl Objective for SquaredNorm<'_> {
+    fn at(&self, t: f64) -> (f64, f64) {
+        self.parts.iter().fold((0.0, 0.0), |(g, dg), p| {
+            let (v, dv) = p.at(t);
+            (g + v * v, dg + 2.0 * v * dv)
+        })
+    }
+    fn fourth_bound(&self, t0: f64) -> f64 {
+        const BINOMIAL: [f64; 5] = [1.0, 4.0, 6.0, 4.0, 1.0];
+        self.parts
+            .iter()
+            .map(|p| {
+                let waves = |k: i32| p.v.derivative_bound(k, t0);
+                let b = [
+                    p.v.constant.abs() + p.v.slope.abs() * p.t_end + waves(0),
+                    p.v.slope.abs() + waves(1),
+                    waves(2),
+                    waves(3),
+                    waves(4),
+                ];
+                (0..5).map(|k| BINOMIAL[k] * b[k] * b[4 - k]).sum::<f64>()
+            })
+            .sum()
+    }
+    fn scale(&self) -> f64 {
+        self.parts.iter().map(|p| p.scale().powi(2)).sum()
+    }
+}
+
+/// The search for the largest |g| of an [`Objective`] on [0, t_end], fed its grid's knots
+/// (g and g′ at increasing times from 0 to t_end, in consecutive pieces that may share
+/// their end knots: a grid the caller may compute faster in bulk, [`grid`]).
+#[derive(Debug, Clone)]
+pub struct PeakSearch<O> {
+    g: O,
+    floor: f64,
+    best: Best,
+    last: Option<Knot>,
+    /// Intervals that might hold a larger value: (interpolated estimate, M₄ from their
+    /// piece's start on, ends).
+    open: Vec<(f64, f64, Knot, Knot)>,
+}
+
+impl<O: Objective> PeakSearch<O> {
+    /// A search for the peak of `g`, to [`TOLERANCE`] of its scale.
+    pub fn new(g: O) -> Self {
+        Self {
+            floor: TOLERANCE * g.scale(),
+            g,
+            best: Best {
+                value: 0.0,
+                time: 0.0,
+            },
+            last: None,
+            open: Vec::new(),
+        }
+    }
+
+    /// The objective, for computing knots.
+    pub fn objective(&self) -> &O {
+        &self.g
+    }
+
+    /// The next knots (the first may repeat the previous piece's last).
+    pub fn feed(&mut self, knots: &[Knot]) {
+        // |g⁗| is bounded from the piece's start on: the bound there holds for all of it.
+        let start = self.last.or(knots.first().copied()).map_or(0.0, |k| k.0);
+        let fourth = self.g.fourth_bound(start);
+        for &k in knots {
+            self.best.offer(k.0, k.1);
+            if let Some(a) = self.last {
+                if k.0 > a.0 {
+                    self.first_pass(a, k, fourth);
+                }
+            }
+            self.last = Some(k);
+        }
+    }
+
+    /// One grid interval: kept when its interpolant plus the bound might beat the best.
+    fn first_pass(&mut self, a: Knot, b: Knot, fourth: f64) {
+        let (est, at) = hermite_max(a, b);
+        if est > self.best.value {
+            self.best.offer(at, self.g.at(at).0);
+        }
+        let bound = fourth * (b.0 - a.0).powi(4) / 384.0;
+        if est + bound > self.best.value + self.floor {
+            self.open.push((est, fourth, a, b));
+            if self.open.len() > 4096 {
+                self.prune();
+            }
+        }
+    }
+
+    /// Drops the kept intervals the best has overtaken.
+    fn prune(&mut self) {
+        let (best, floor) = (self.best.value, self.floor);
+        self.open.retain(|(est, fourth, a, b)| {
+            *est + fourth * (b.0 - a.0).powi(4) / 384.0 > best + floor
+        });
+    }
+
+    /// The peak |g| and its time.
+    pub fn finish(mut self) -> (f64, f64) {
+        let mut open = std::mem::take(&mut self.open);
+        open.sort_by(|x, y| y.0.total_cmp(&x.0));
+        for (_, fourth, a, b) in open {
+            refine(&self.g, (a, b), fourth, 0, self.floor, &mut self.best);
+        }
+        (self.best.value, self.best.time)
+    }
+}
+
+/// Halves [a, b] while it might hold a value above the best by more than `floor` (`fourth`
+/// bounds |v⁗| on it).
+fn refine(
+    g: &dyn Objective,
+    (a, b): (Knot, Knot),
+    fourth: f64,
+    depth: usize,
+    floor: f64,
+    best: &mut Best,
+) {
+    let h = b.0 - a.0;
+    let (est, at) = hermite_max(a, b);
+    let bound = fourth * h.powi(4) / 384.0;
+    if est + bound <= best.value + floor {
+        return;
+    }
+    if bound <= floor || depth >= MAX_DEPTH {
+        best.offer(at, g.at(at).0);
+        return;
+    }
+    let tm = 0.5 * (a.0 + b.0);
+    let (gm, dgm) = g.at(tm);
+    let m = (tm, gm, dgm);
+    best.offer(tm, m.1);
+    // The half with the larger interpolated value first: it raises the best sooner.
+    let (left, right) = (hermite_max(a, m).0, hermite_max(m, b).0);
+    if left >= right {
+        refine(g, (a, m), fourth, depth + 1, floor, best);
+        refine(g, (m, b), fourth, depth + 1, floor, best);
+    } else {
+        refine(g, (m, b), fourth, depth + 1, floor, best);
+        refine(g, (a, m), fourth, depth + 1, floor, best);
+    }
+}
+
+/// The first pass's grid on [0, t_end]: spacing at most [`GRID_FRACTION`]·π / ω_max (ω_max
+/// the fastest wave's |λ|), at least one interval.
+pub fn grid(fastest: f64, t_end: f64) -> Vec<f64> {
+    let n = if fastest > 0.0 && t_end > 0.0 {
+        (t_end * fastest / (GRID_FRACTION * std::f64::consts::PI))
+            .ceil()
+            .max(1.0)
+    } else {
+        1.0
+    };
+    let n = n as usize;
+    (0..=n).map(|k| t_end * k as f64 / n as f64).collect()
+}
+
+/// The largest |v| on [0, t_end] and its time, evaluating the grid in closed form (one
+/// signal; [`PeakSearch`] fed in bulk when many signals share a grid).
+pub fn peak(v: &WaveSum, t_end: f64) -> (f64, f64) {
+    let mut search = PeakSearch::new(Scalar::new(v, t_end));
+    let knots: Vec<Knot> = grid(v.fastest(), t_end)
+        .into_iter()
+        .map(|t| {
+            let (g, dg) = search.objective().at(t);
+            (t, g, dg)
+        })
+        .collect();
+    search.feed(&knots);
+    search.finish()
+}
+
+/// The largest magnitude √(Σ v_c²) of a vector of signals on [0, t_end] and its time.
+pub fn norm_peak(vs: &[&WaveSum], t_end: f64) -> (f64, f64) {
+    let fastest = vs.iter().map(|v| v.fastest()).fold(0.0, f64::max);
+    let mut search = PeakSearch::new(SquaredNorm::new(vs, t_end));
+    let knots: Vec<Knot> = grid(fastest, t_end)
+        .into_iter()
+        .map(|t| {
+            let (g, dg) = search.objective().at(t);
+            (t, g, dg)
+        })
+        .collect();
+    search.feed(&knots);
+    let (g, t) = search.finish();
+    (g.sqrt(), t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_of_a_cubic_is_the_cubic() {
+        // v = 1 + 3s − 4s³ on [0, 1]: v′ = 3 − 12s² = 0 at s = 1/2, v = 2.
+        let f = |s: f64| 1.0 + 3.0 * s - 4.0 * s.powi(3);
+        let d = |s: f64| 3.0 - 12.0 * s * s;
+        let (v, t) = hermite_max((0.0, f(0.0), d(0.0)), (1.0, f(1.0), d(1.0)));
+        assert!(
+            (v - 2.0).abs() < 1e-14 && (t - 0.5).abs() < 1e-14,
+            "{v} {t}"
+        );
+    }
+
+    #[test]
+    fn quadratic_roots_without_cancellation() {
+        let (r, n) = quadratic_roots(1.0, -1e8, 1.0);
+        let small = r[..n].iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(n == 2 && (small - 1e-8).abs() < 1e-22, "{small:e}");
+        assert_eq!(quadratic_roots(0.0, 2.0, -1.0), ([0.5, 0.0], 1));
+        assert_eq!(quadratic_roots(1.0, 0.0, 1.0).1, 0);
+    }
+}
