@@ -109,6 +109,16 @@ fn fmt_bound(v: f64) -> String {
     }
 }
 
+/// Allowable stresses (`[materials.X] allowable_stress`).
+pub const ALLOWABLE_STRESS: Limit = closed(1e3, 1e13, "Pa");
+/// Factors of safety (`[materials.X] factor_of_safety`): below 1 is no safety.
+pub const FACTOR_OF_SAFETY: Limit = closed(1.0, 100.0, "");
+/// Transverse-shear factors of a general section (τ_max = k V/A; 1 for a uniform shear, 1.5
+/// for a rectangle, 2 for a thin tube).
+pub const SHEAR_FACTOR: Limit = closed(1.0, 10.0, "");
+/// A latch's allowable moment (`[deployment.latch] moment_allowable`).
+pub const LATCH_MOMENT_ALLOWABLE: Limit = closed(1e-6, 1e12, "N·m");
+
 /// Lengths of members: beam length, plate length and width, hub cylinder diameter and length.
 pub const LENGTH: Limit = closed(1e-3, 1e4, "m");
 /// Cross-section sizes: tube diameter and wall, plate thickness, hub wall.

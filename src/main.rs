@@ -96,6 +96,11 @@ enum Command {
         /// No progress bar (it is shown only on a terminal, for runs longer than a second).
         #[arg(long, short)]
         quiet: bool,
+        /// Exit with status 3, naming the component and the time, when a margin of safety is
+        /// negative (beams against `[materials.X] allowable_stress`, latches against
+        /// `[deployment.latch] moment_allowable`); the outputs are written first.
+        #[arg(long)]
+        fail_on_negative_margin: bool,
     },
     /// Monte Carlo dispersions of the deployment ([montecarlo]; docs/montecarlo.md): runs
     /// with dispersed values, requirement verdicts by order statistics, sharding for
@@ -117,7 +122,8 @@ fn main() -> ExitCode {
             common,
             open,
             quiet,
-        } => run_simulate(&common, open, quiet),
+            fail_on_negative_margin,
+        } => run_simulate(&common, open, quiet, fail_on_negative_margin),
         Command::Montecarlo(a) => mc_cli::run(&a),
     };
     done.err().unwrap_or(ExitCode::SUCCESS)
@@ -152,6 +158,8 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
 /// a result, not an error.
 const REFUSED: u8 = 2;
 const FAILED: u8 = 1;
+/// `simulate --fail-on-negative-margin` found a negative margin of safety.
+const NEGATIVE_MARGIN: u8 = 3;
 
 /// Reads and validates the scenario and checks that the run fits the memory budget,
 /// reporting a refusal with its location.
@@ -404,7 +412,12 @@ fn run_deploy(c: &Common) -> Result<(), ExitCode> {
     )
 }
 
-fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
+fn run_simulate(
+    c: &Common,
+    open: bool,
+    quiet: bool,
+    fail_on_negative_margin: bool,
+) -> Result<(), ExitCode> {
     use flexcraft::simulation::Simulation;
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
     let started = std::time::Instant::now();
@@ -443,6 +456,30 @@ fn run_simulate(c: &Common, open: bool, quiet: bool) -> Result<(), ExitCode> {
     }
     if let (true, Some(dir)) = (open, out) {
         open_in_browser(&dir.join("report.html"));
+    }
+    if fail_on_negative_margin {
+        let negative: Vec<_> = output::margins::margins(&scenario, &sim)
+            .into_iter()
+            .filter(|m| m.margin < 0.0)
+            .collect();
+        for m in &negative {
+            eprintln!(
+                "error: {}: negative margin of safety {:+.3}: {} at t = {:.3} s from release \
+                 ({:.4e} {} against {:.4e} {} / FS {})",
+                path.display(),
+                m.margin,
+                m.component,
+                m.time,
+                m.value,
+                m.unit,
+                m.allowable,
+                m.unit,
+                m.factor_of_safety
+            );
+        }
+        if !negative.is_empty() {
+            return Err(ExitCode::from(NEGATIVE_MARGIN));
+        }
     }
     Ok(())
 }

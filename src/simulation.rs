@@ -41,6 +41,9 @@ pub struct Response {
     pub channels: Vec<Channel>,
     /// Sampled history.
     pub history: ResponseHistory,
+    /// Every beam's stresses along its length (beams whose section's fibres are known:
+    /// tubes, and general sections with their fibre keys; docs/theory.md §3.3).
+    pub stresses: Vec<crate::response::stress::BeamStresses>,
 }
 
 /// Everything `simulate` computes.
@@ -132,11 +135,19 @@ impl Simulation {
                 channels.extend(latch_channels(&model, &d.plate, &d.chain.hinges));
                 let history = modal.sample(&modes, &channels, settings);
                 warnings.extend(large_deflections(&model, &channels, &history));
+                let stresses = crate::response::stress::beam_stresses(
+                    &model,
+                    &modes,
+                    &modal,
+                    &scenario.stress,
+                    settings.duration,
+                );
                 Some(Response {
                     handover,
                     modal,
                     channels,
                     history,
+                    stresses,
                 })
             }
             Err(ResponseError::NotLatched { .. }) => {

@@ -40,5 +40,6 @@ mod suite {
     pub mod report;
     pub mod response;
     pub mod response_loads;
+    pub mod stresses;
     pub mod term_selection;
 }

@@ -914,6 +914,7 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     for w in &sim.warnings {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
+    o.push_str(&super::margins::margins_table(s, sim));
     for f in super::figures::response_figures(s, r) {
         o.push_str(&plot(&f));
     }

@@ -104,7 +104,7 @@ fn overall(dep: Option<Peak>, resp: Option<Peak>) -> Value {
 
 /// Peak root loads of every beam and peak latch moments, over the deployment and the
 /// response (times from release).
-fn peak_loads(sim: &Simulation) -> Value {
+pub(super) fn peak_loads(sim: &Simulation) -> Value {
     let dep = &sim.deployment;
     let r = sim.response.as_ref();
     let find = |pred: &dyn Fn(&ChannelKind) -> bool| -> Vec<usize> {
@@ -206,6 +206,8 @@ pub fn simulate_json(s: &Scenario, sim: &Simulation) -> String {
             "first_frequencies_hz": sim.modes.elastic().take(10).map(|m| m.frequency_hz()).collect::<Vec<_>>(),
         },
         "peak_loads": peak_loads(sim),
+        "stresses": super::margins::stresses_json(sim),
+        "margins": super::margins::margins_json(s, sim),
         "handover": Value::Null,
         "response": Value::Null,
         "warnings": sim.all_warnings().map(ToString::to_string).collect::<Vec<_>>(),
@@ -437,6 +439,7 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
         let k = l["hinge"].as_u64().unwrap_or(0);
         line(o, format!("latch moment, hinge {k}"), "N·m", &l["overall"]);
     }
+    super::margins::stress_lines(o, s, sim);
     let (rv, rw) = r.hub_rigid_rates(&sim.modes);
     let finals = |kind: ChannelKind| -> String {
         let v: Vec<String> = r

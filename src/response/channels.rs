@@ -12,7 +12,7 @@ use crate::ritz::assembly::{ElementKind, FieldKind};
 use crate::ritz::RitzModel;
 
 /// What a channel measures.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum ChannelKind {
     /// A beam tip's elastic deflection (m) or twist (rad).
     BeamTip {
@@ -33,6 +33,14 @@ pub enum ChannelKind {
     BeamRoot {
         /// Beam name.
         beam: String,
+    },
+    /// A stress resultant of a beam's section along its length (N or N·m: N, V_y, V_z, T,
+    /// M_y, M_z on the positive face, beam axes; [`super::sections`]).
+    BeamSection {
+        /// Beam name.
+        beam: String,
+        /// Station, m from the root.
+        station: f64,
     },
     /// A latch's moment on its hinge (N·m) in the deployed wing ([`super::loads`]).
     LatchMoment {

@@ -139,6 +139,13 @@ impl Best {
     }
 }
 
+/// A cheap bound on the largest |H| of the cubic Hermite interpolant through two knots:
+/// with H = v₀h₀₀ + v₁h₀₁ + h(v₀′h₁₀ + v₁′h₁₁), h₀₀ + h₀₁ = 1, both ≥ 0, and |h₁₀|, |h₁₁| ≤ 4/27,
+/// |H| ≤ max(|v₀|, |v₁|) + (4/27) h (|v₀′| + |v₁′|).
+pub fn hermite_bound(a: Knot, b: Knot) -> f64 {
+    a.1.abs().max(b.1.abs()) + 4.0 / 27.0 * (b.0 - a.0) * (a.2.abs() + b.2.abs())
+}
+
 /// The largest |H| of the cubic Hermite interpolant through two knots, and where.
 pub fn hermite_max(a: Knot, b: Knot) -> (f64, f64) {
     let h = b.0 - a.0;
@@ -335,11 +342,14 @@ impl<O: Objective> PeakSearch<O> {
 
     /// One grid interval: kept when its interpolant plus the bound might beat the best.
     fn first_pass(&mut self, a: Knot, b: Knot, fourth: f64) {
+        let bound = fourth * (b.0 - a.0).powi(4) / 384.0;
+        if hermite_bound(a, b) + bound <= self.best.value + self.floor {
+            return;
+        }
         let (est, at) = hermite_max(a, b);
         if est > self.best.value {
             self.best.offer(at, self.g.at(at).0);
         }
-        let bound = fourth * (b.0 - a.0).powi(4) / 384.0;
         if est + bound > self.best.value + self.floor {
             self.open.push((est, fourth, a, b));
             if self.open.len() > 4096 {

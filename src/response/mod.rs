@@ -8,6 +8,8 @@ pub mod channels;
 pub mod extrema;
 pub mod handover;
 pub mod loads;
+pub mod sections;
+pub mod stress;
 pub mod superposition;
 
 pub use channels::{Channel, ChannelKind, Order};

@@ -14,7 +14,7 @@ use super::channels::{Channel, ChannelKind, Order};
 use super::extrema::{self, PeakSearch, Scalar, SquaredNorm, Wave, WaveSum};
 use super::ResponseSettings;
 use crate::ritz::ModalAnalysis;
-use faer::Mat;
+use faer::{Mat, MatRef};
 
 /// One mode kept in the response.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -253,6 +253,90 @@ impl ModalResponse {
             .collect()
     }
 
+    /// Every channel's value (offset included) and slope on the uniform `grid` (t_i = i·h),
+    /// in consecutive pieces that share their end rows: `f(times, values, slopes)` with
+    /// rows × channels matrices. The modes are evaluated on the grid and the channels from
+    /// them by one matrix product per piece.
+    pub fn on_grid(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+        grid: &[f64],
+        f: &mut GridPiece<'_>,
+    ) {
+        if grid.is_empty() {
+            return;
+        }
+        let (gd, ga) = (
+            self.gains(modal, channels, Order::Displacement),
+            self.gains(modal, channels, Order::Acceleration),
+        );
+        let nm = self.modes.len();
+        let zeta = self.damping_ratio;
+        let h = if grid.len() > 1 {
+            grid[1] - grid[0]
+        } else {
+            0.0
+        };
+        let chunk = PEAK_CHUNK.min(grid.len());
+        let (mut e, mut ed, mut edd, mut eddd) = (
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+            Mat::<f64>::zeros(chunk, nm),
+        );
+        let mut values = Mat::<f64>::zeros(chunk, channels.len());
+        let mut slopes = Mat::<f64>::zeros(chunk, channels.len());
+        let mut start = 0;
+        loop {
+            let end = (start + chunk - 1).min(grid.len() - 1);
+            let rows = end - start + 1;
+            // η, η̇, η̈ = −2ζωη̇ − ω²η and η⃛ = −2ζωη̈ − ω²η̇ of every mode at the piece's times.
+            for (j, m) in self.modes.iter().enumerate() {
+                let w = if m.rigid { 0.0 } else { m.omega_rad_s };
+                let (x, xd) = (
+                    e.col_mut(j)
+                        .try_as_col_major_mut()
+                        .expect("a fresh Mat is column-major")
+                        .as_slice_mut(),
+                    ed.col_mut(j)
+                        .try_as_col_major_mut()
+                        .expect("a fresh Mat is column-major")
+                        .as_slice_mut(),
+                );
+                fill_state(m, zeta, grid[start], h, &mut x[..rows], &mut xd[..rows]);
+                for i in 0..rows {
+                    let (x, xd) = (e[(i, j)], ed[(i, j)]);
+                    let xdd = -2.0 * zeta * w * xd - w * w * x;
+                    edd[(i, j)] = xdd;
+                    eddd[(i, j)] = -2.0 * zeta * w * xdd - w * w * xd;
+                }
+            }
+            values
+                .subrows_mut(0, rows)
+                .copy_from(e.subrows(0, rows) * &gd + edd.subrows(0, rows) * &ga);
+            slopes
+                .subrows_mut(0, rows)
+                .copy_from(ed.subrows(0, rows) * &gd + eddd.subrows(0, rows) * &ga);
+            for (c, ch) in channels.iter().enumerate() {
+                if ch.offset != 0.0 {
+                    for i in 0..rows {
+                        values[(i, c)] += ch.offset;
+                    }
+                }
+            }
+            f(
+                &grid[start..=end],
+                values.subrows(0, rows),
+                slopes.subrows(0, rows),
+            );
+            if end + 1 >= grid.len() {
+                break;
+            }
+            start = end;
+        }
+    }
+
     /// The largest |value| of every channel on [0, duration] and its time, and the largest
     /// magnitude √(Σ v_c²) of every group of channels (a force's or a moment's components),
     /// exact to [`extrema::TOLERANCE`] of the channel's scale at any output rate
@@ -279,88 +363,25 @@ impl ModalResponse {
             .iter()
             .map(|s| PeakSearch::new(Scalar::new(s, duration.max(0.0))))
             .collect();
-        let (gd, ga) = (
-            self.gains(modal, channels, Order::Displacement),
-            self.gains(modal, channels, Order::Acceleration),
-        );
-        let nm = self.modes.len();
-        let zeta = self.damping_ratio;
-        // The grid is uniform: t_i = i·h.
-        let h = if grid.len() > 1 { grid[1] } else { 0.0 };
-        let chunk = PEAK_CHUNK.min(grid.len());
-        let (mut e, mut ed, mut edd, mut eddd) = (
-            Mat::<f64>::zeros(chunk, nm),
-            Mat::<f64>::zeros(chunk, nm),
-            Mat::<f64>::zeros(chunk, nm),
-            Mat::<f64>::zeros(chunk, nm),
-        );
-        let mut values = Mat::<f64>::zeros(chunk, channels.len());
-        let mut slopes = Mat::<f64>::zeros(chunk, channels.len());
-        let mut knots = Vec::with_capacity(chunk);
-        let mut start = 0;
-        loop {
-            // Pieces share their end knots.
-            let end = (start + chunk - 1).min(grid.len() - 1);
-            let rows = end - start + 1;
-            // η, η̇, η̈ = −2ζωη̇ − ω²η and η⃛ = −2ζωη̈ − ω²η̇ of every mode at the piece's times.
-            for (j, m) in self.modes.iter().enumerate() {
-                let w = if m.rigid { 0.0 } else { m.omega_rad_s };
-                let (x, xd) = (
-                    e.col_mut(j)
-                        .try_as_col_major_mut()
-                        .expect("column-major")
-                        .as_slice_mut(),
-                    ed.col_mut(j)
-                        .try_as_col_major_mut()
-                        .expect("column-major")
-                        .as_slice_mut(),
-                );
-                fill_state(m, zeta, grid[start], h, &mut x[..rows], &mut xd[..rows]);
-                for i in 0..rows {
-                    let (x, xd) = (e[(i, j)], ed[(i, j)]);
-                    let xdd = -2.0 * zeta * w * xd - w * w * x;
-                    edd[(i, j)] = xdd;
-                    eddd[(i, j)] = -2.0 * zeta * w * xdd - w * w * xd;
-                }
-            }
-            let (er, edr, eddr, edddr) = (
-                e.subrows(0, rows),
-                ed.subrows(0, rows),
-                edd.subrows(0, rows),
-                eddd.subrows(0, rows),
-            );
-            let mut v = values.subrows_mut(0, rows);
-            v.copy_from(er * &gd + eddr * &ga);
-            let mut d = slopes.subrows_mut(0, rows);
-            d.copy_from(edr * &gd + edddr * &ga);
+        let mut knots = Vec::new();
+        self.on_grid(modal, channels, &grid, &mut |times, values, slopes| {
+            let rows = times.len();
             for (c, search) in searches.iter_mut().enumerate() {
                 knots.clear();
-                knots.extend((0..rows).map(|i| {
-                    (
-                        grid[start + i],
-                        values[(i, c)] + channels[c].offset,
-                        slopes[(i, c)],
-                    )
-                }));
+                knots.extend((0..rows).map(|i| (times[i], values[(i, c)], slopes[(i, c)])));
                 search.feed(&knots);
             }
             for (group, search) in groups.iter().zip(&mut norms) {
                 knots.clear();
                 knots.extend((0..rows).map(|i| {
-                    group
-                        .iter()
-                        .fold((grid[start + i], 0.0, 0.0), |(t, g, dg), &c| {
-                            let v = values[(i, c)] + channels[c].offset;
-                            (t, g + v * v, dg + 2.0 * v * slopes[(i, c)])
-                        })
+                    group.iter().fold((times[i], 0.0, 0.0), |(t, g, dg), &c| {
+                        let v = values[(i, c)];
+                        (t, g + v * v, dg + 2.0 * v * slopes[(i, c)])
+                    })
                 }));
                 search.feed(&knots);
             }
-            if end + 1 >= grid.len() {
-                break;
-            }
-            start = end;
-        }
+        });
         (
             searches.into_iter().map(PeakSearch::finish).collect(),
             norms
@@ -400,6 +421,9 @@ fn vector_groups(channels: &[Channel]) -> Vec<Vec<usize>> {
     }
     out
 }
+
+/// What [`ModalResponse::on_grid`] hands each piece: (times, values, slopes).
+pub type GridPiece<'a> = dyn FnMut(&[f64], MatRef<'_, f64>, MatRef<'_, f64>) + 'a;
 
 /// A peak |value| and its time (s after the hand-over).
 pub type Peak = (f64, f64);

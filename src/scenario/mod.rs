@@ -18,6 +18,7 @@ mod plates;
 mod raw;
 mod response;
 mod ritz;
+mod stress;
 
 pub use budget::{default_memory_budget, format_bytes, Estimate, RunParts};
 pub use deployment::{DEFAULT_END_TIME, DEFAULT_OUTPUT_RATE, DEFAULT_TOLERANCE};
@@ -51,6 +52,8 @@ pub struct Scenario {
     pub term_selection: Option<crate::ritz::refine::TermSelection>,
     /// The `[montecarlo]` section (docs/montecarlo.md), when present.
     pub montecarlo: Option<crate::montecarlo::MonteCarlo>,
+    /// Allowables, section fibres and the latch's allowable moment (stresses and margins).
+    pub stress: crate::response::stress::StressSpec,
     /// Where each component was written, to locate a failure found after parsing.
     sources: Sources,
 }
@@ -455,6 +458,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         )?),
         None => None,
     };
+    let stress = stress::lower(cx, &raw)?;
     Ok(Scenario {
         name,
         structure,
@@ -463,6 +467,7 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         export,
         term_selection,
         montecarlo,
+        stress,
         sources: sources(cx, &raw),
     })
 }

@@ -101,6 +101,8 @@ pub struct RawMaterial {
     pub poisson_ratio: S<f64>,
     pub shear_modulus: Option<S<f64>>,
     pub density: S<f64>,
+    pub allowable_stress: Option<S<f64>>,
+    pub factor_of_safety: Option<S<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -121,6 +123,11 @@ pub struct RawSection {
     pub polar_inertia: Option<S<f64>>,
     #[serde(default, deserialize_with = "maybe_three")]
     pub y_axis: Option<S<[f64; 3]>>,
+    pub y_extreme: Option<S<f64>>,
+    pub z_extreme: Option<S<f64>>,
+    pub torsion_radius: Option<S<f64>>,
+    pub shear_factor_y: Option<S<f64>>,
+    pub shear_factor_z: Option<S<f64>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -247,6 +254,7 @@ pub struct RawLatch {
     pub stiffness: Option<S<RawPerHinge>>,
     pub damping: Option<S<RawPerHinge>>,
     pub settle_time: Option<S<f64>>,
+    pub moment_allowable: Option<S<f64>>,
 }
 
 #[derive(Debug, Deserialize, Clone, Copy, PartialEq, Eq)]
