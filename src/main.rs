@@ -85,7 +85,8 @@ enum Command {
     /// at the final latch (or once compliant latches have settled) and the latch-excited
     /// vibration, hub drift and attitude motion.
     /// --out writes report.html (one self-contained page), summary.json, modes.json,
-    /// deployment.csv, events.json, response.csv and plots.
+    /// deployment.csv, events.json, response.csv, hub.csv (a free hub from release to the end
+    /// of the response, inertial axes) and plots.
     #[command(after_help = UNITS)]
     Simulate {
         #[command(flatten)]

@@ -42,6 +42,30 @@ pub fn rate(q: Quaternion, w: Vec3) -> Quaternion {
     ]
 }
 
+/// The unit quaternion of a rotation vector θ (axis × angle): [cos(|θ|/2), sin(|θ|/2) θ/|θ|].
+pub fn from_rotation_vector(theta: Vec3) -> Quaternion {
+    let angle = theta.norm();
+    if angle < 1e-300 {
+        return [1.0, 0.0, 0.0, 0.0];
+    }
+    let (s, c) = (0.5 * angle).sin_cos();
+    let v = theta * (s / angle);
+    [c, v.0[0], v.0[1], v.0[2]]
+}
+
+/// The Hamilton product a ⊗ b: the rotation b, then a (body-to-inertial quaternions: a
+/// body's attitude a, and b a further rotation in its body axes).
+pub fn product(a: Quaternion, b: Quaternion) -> Quaternion {
+    let [a0, a1, a2, a3] = a;
+    let [b0, b1, b2, b3] = b;
+    [
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+    ]
+}
+
 /// The rotation vector (axis × angle, |angle| ≤ π) of a quaternion.
 pub fn rotation_vector(q: Quaternion) -> Vec3 {
     let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
@@ -132,6 +156,17 @@ pub fn left_jacobian_rate(theta: Vec3, theta_dot: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quaternion_product_is_the_matrix_product() {
+        // matrix(a ⊗ b) = matrix(a) · matrix(b), and the rotation vector round-trips.
+        let (ta, tb) = (Vec3::new(0.3, -1.2, 0.7), Vec3::new(-0.4, 0.2, 2.1));
+        let (a, b) = (from_rotation_vector(ta), from_rotation_vector(tb));
+        close(matrix(product(a, b)), matrix(a).matmul(matrix(b)), 1e-14);
+        close(matrix(a), exp(ta), 1e-14);
+        let back = rotation_vector(a);
+        assert!((back - ta).norm() < 1e-14, "{back:?}");
+    }
 
     fn close(a: Mat3, b: Mat3, tol: f64) {
         for i in 0..3 {

@@ -55,7 +55,12 @@ pub fn decimate(n: usize, y: impl Fn(usize) -> f64, max_points: usize) -> Vec<us
 }
 
 /// A curve of the samples `0..n` (x(k), y(k)), decimated to [`PLOT_POINTS`].
-fn curve(name: String, n: usize, x: impl Fn(usize) -> f64, y: impl Fn(usize) -> f64) -> Curve {
+pub(super) fn curve(
+    name: String,
+    n: usize,
+    x: impl Fn(usize) -> f64,
+    y: impl Fn(usize) -> f64,
+) -> Curve {
     let idx = decimate(n, &y, PLOT_POINTS);
     let xs = idx.iter().map(|&k| x(k)).collect();
     let ys = idx.iter().map(|&k| y(k)).collect();

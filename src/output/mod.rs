@@ -7,6 +7,7 @@ mod deploy;
 mod export;
 pub(crate) mod figures;
 pub mod flex42;
+pub mod hub;
 pub mod margins;
 mod modes;
 mod montecarlo;

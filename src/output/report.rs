@@ -915,6 +915,9 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
         let _ = writeln!(o, "<p class=\"warn\">warning: {}</p>", esc(&w.to_string()));
     }
     o.push_str(&super::margins::margins_table(s, sim));
+    for f in super::hub::figures(sim) {
+        o.push_str(&plot(&f));
+    }
     for f in super::figures::response_figures(s, r) {
         o.push_str(&plot(&f));
     }

@@ -543,6 +543,12 @@ pub fn write_simulate(
     for f in super::figures::response_figures(s, r) {
         f.draw(dir)?;
     }
+    if let Some(text) = super::hub::csv(sim) {
+        dir.write("hub.csv", text)?;
+    }
+    for f in super::hub::figures(sim) {
+        f.draw(dir)?;
+    }
     Ok(())
 }
 
