@@ -130,6 +130,12 @@ impl Simulation {
                         });
                     }
                 }
+                if let Some(highest) = aliased(&modal, settings) {
+                    warnings.push(Warning::Aliasing {
+                        output_rate: settings.output_rate,
+                        highest_hz: highest,
+                    });
+                }
                 let mut channels = standard_channels(&model);
                 channels.extend(beam_root_channels(&model));
                 channels.extend(latch_channels(&model, &d.plate, &d.chain.hinges));
@@ -208,4 +214,16 @@ fn large_deflections(
         }
     }
     out
+}
+
+/// The highest kept elastic frequency (Hz) when the response's output rate is below 2.5
+/// times it (the samples then alias the ringing), None otherwise.
+pub fn aliased(modal: &ModalResponse, settings: &crate::response::ResponseSettings) -> Option<f64> {
+    let highest = modal
+        .modes
+        .iter()
+        .filter(|m| !m.rigid)
+        .map(|m| m.omega_rad_s / (2.0 * std::f64::consts::PI))
+        .fold(0.0, f64::max);
+    (highest > 0.0 && settings.output_rate < 2.5 * highest).then_some(highest)
 }

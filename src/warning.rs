@@ -39,6 +39,15 @@ pub enum Warning {
     },
     /// No hand-over and no response, because the array did not latch completely.
     NoResponse,
+    /// The response's output rate is below 2.5 times its highest kept frequency: its samples
+    /// cannot show the ringing, so the figures draw the solution's min/max envelope (the peaks
+    /// are the solution's in any case).
+    Aliasing {
+        /// `response.output_rate`, Hz.
+        output_rate: f64,
+        /// The highest kept elastic frequency, Hz.
+        highest_hz: f64,
+    },
     /// More elastic modes requested than the model has: all are kept.
     ModesClamped {
         /// `response.modes`.
@@ -148,9 +157,11 @@ impl fmt::Display for Warning {
                     list.join(", ")
                 )
             }
-            Self::NoResponse => {
-                f.write_str("the array did not latch completely: no hand-over, no response")
-            }
+            Self::NoResponse => f.write_str(NO_RESPONSE),
+            Self::Aliasing {
+                output_rate,
+                highest_hz,
+            } => aliasing(f, *output_rate, *highest_hz),
             Self::ModesClamped {
                 requested,
                 available,
@@ -229,6 +240,19 @@ impl fmt::Display for Warning {
             Self::HandoverNote(note) => f.write_str(note),
         }
     }
+}
+
+/// [`Warning::NoResponse`]'s text.
+const NO_RESPONSE: &str = "the array did not latch completely: no hand-over, no response";
+
+/// [`Warning::Aliasing`]'s text.
+fn aliasing(f: &mut fmt::Formatter<'_>, output_rate: f64, highest_hz: f64) -> fmt::Result {
+    write!(
+        f,
+        "response.output_rate = {output_rate} Hz is below 2.5 times the highest kept mode \
+         ({highest_hz:.4} Hz): the samples (response.csv) alias its ringing; the figures draw \
+         the solution's min/max envelope and every peak is the solution's"
+    )
 }
 
 /// [`Warning::AccuracyNotReached`]'s text.

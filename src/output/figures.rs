@@ -3,6 +3,7 @@
 
 use crate::deploy::{Deployment, DeploymentResult, Sample};
 use crate::response::{Channel, ChannelKind};
+use crate::ritz::ModalAnalysis;
 use crate::scenario::Scenario;
 use crate::simulation::Response;
 
@@ -407,22 +408,33 @@ fn body_figures(r: &DeploymentResult, beam_names: &[String], markers: &[f64]) ->
 
 /// The paper's figures 2.4–2.7 (every beam's tip deflection and twist, every plate's tip
 /// corners, hub translation and rotation) and the first eight elastic modal amplitudes.
-pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
+pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Vec<Figure> {
     let hist = &r.history;
     let n = hist.times.len();
     let t = |k: usize| hist.times[k];
+    // Where the samples would alias the kept modes, the channels are drawn as the solution's
+    // min/max envelope, one pair per plot column (docs/theory.md §3.2).
+    let envelope = crate::simulation::aliased(&r.modal, &s.response).map(|_| {
+        r.modal.envelopes(
+            modes,
+            &r.channels,
+            s.response.duration,
+            (PLOT_POINTS - 2) / 2,
+        )
+    });
+    let env = envelope.as_deref();
     let pick = |f: &dyn Fn(&Channel) -> bool| -> Vec<Curve> {
         r.channels
             .iter()
             .enumerate()
             .filter(|(_, c)| f(c))
-            .map(|(j, c)| curve(c.label.clone(), n, t, |k| hist.values[(k, j)]))
+            .map(|(j, c)| channel_curve(r, env, j, c))
             .collect()
     };
     let fig = |stem: String, title: String, ylabel: &'static str, curves| Figure {
         markers: Vec::new(),
         stem,
-        title,
+        title: envelope_title(title, env),
         xlabel: "t after the latch [s]",
         ylabel,
         curves,
@@ -481,7 +493,7 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
         "rotation [rad]",
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));
-    out.extend(load_figures(s, r, &stems));
+    out.extend(load_figures(s, r, &stems, env));
     let modal: Vec<Curve> = r
         .modal
         .modes
@@ -508,29 +520,57 @@ pub fn response_figures(s: &Scenario, r: &Response) -> Vec<Figure> {
     out
 }
 
+/// Response channel `j`: its samples (decimated), or its min/max envelope from the solution
+/// where the samples would alias.
+fn channel_curve(r: &Response, env: Option<&[Vec<(f64, f64)>]>, j: usize, c: &Channel) -> Curve {
+    match env.and_then(|e| e.get(j)) {
+        Some(points) => (
+            c.label.clone(),
+            points.iter().map(|p| p.0).collect(),
+            points.iter().map(|p| p.1).collect(),
+        ),
+        None => {
+            let hist = &r.history;
+            curve(
+                c.label.clone(),
+                hist.times.len(),
+                |k| hist.times[k],
+                |k| hist.values[(k, j)],
+            )
+        }
+    }
+}
+
+/// A response figure's title, saying when it draws the solution's envelope.
+fn envelope_title(title: String, env: Option<&[Vec<(f64, f64)>]>) -> String {
+    if env.is_some() {
+        format!(
+            "{title} — min/max envelope of the solution (the output rate is below 2.5× the highest kept mode)"
+        )
+    } else {
+        title
+    }
+}
+
 /// The response's load figures: every beam's root moment, and the latch moments.
-fn load_figures(s: &Scenario, r: &Response, stems: &[String]) -> Vec<Figure> {
-    let hist = &r.history;
-    let n = hist.times.len();
+fn load_figures(
+    s: &Scenario,
+    r: &Response,
+    stems: &[String],
+    env: Option<&[Vec<(f64, f64)>]>,
+) -> Vec<Figure> {
     let pick = |f: &dyn Fn(&Channel) -> bool| -> Vec<Curve> {
         r.channels
             .iter()
             .enumerate()
             .filter(|(_, c)| f(c))
-            .map(|(j, c)| {
-                curve(
-                    c.label.clone(),
-                    n,
-                    |k| hist.times[k],
-                    |k| hist.values[(k, j)],
-                )
-            })
+            .map(|(j, c)| channel_curve(r, env, j, c))
             .collect()
     };
     let fig = |stem: String, title: String, curves| Figure {
         markers: Vec::new(),
         stem,
-        title,
+        title: envelope_title(title, env),
         xlabel: "t after the latch [s]",
         ylabel: "moment [N·m]",
         curves,

@@ -172,7 +172,8 @@ pub fn csv(sim: &Simulation) -> Option<String> {
 }
 
 /// The hub's attitude and rate from release to the end of the response, the latches and
-/// the hand-over marked (none for a fixed hub).
+/// the hand-over marked by vertical lines (none for a fixed hub); rounding noise drawn as
+/// zero and labelled so, as in the other figures.
 pub fn figures(sim: &Simulation) -> Vec<Figure> {
     let Some(rows) = timeline(sim) else {
         return Vec::new();
@@ -198,10 +199,10 @@ pub fn figures(sim: &Simulation) -> Vec<Figure> {
             })
             .collect()
     };
-    vec![
+    let mut figs = vec![
         Figure {
             stem: "hub_attitude".into(),
-            title: "hub attitude from release (rotation vector, inertial axes = the hub's at release; latches and the hand-over marked)".into(),
+            title: "hub attitude from release (rotation vector, inertial axes)".into(),
             xlabel: "t from release [s]",
             ylabel: "rotation [rad]",
             curves: curves("rotation", &|r| r.rotation),
@@ -209,11 +210,16 @@ pub fn figures(sim: &Simulation) -> Vec<Figure> {
         },
         Figure {
             stem: "hub_rate".into(),
-            title: "hub angular rate from release (inertial axes; latches and the hand-over marked)".into(),
+            title: "hub angular rate from release (inertial axes)".into(),
             xlabel: "t from release [s]",
             ylabel: "rate [rad/s]",
             curves: curves("rate", &|r| r.rate),
             markers,
         },
-    ]
+    ];
+    super::figures::clean(
+        &mut figs,
+        super::figures::structure_size(&sim.model.structure),
+    );
+    figs
 }

@@ -918,7 +918,7 @@ fn response_section(s: &Scenario, sim: &Simulation) -> String {
     for f in super::hub::figures(sim) {
         o.push_str(&plot(&f));
     }
-    for f in super::figures::response_figures(s, r) {
+    for f in super::figures::response_figures(s, r, &sim.modes) {
         o.push_str(&plot(&f));
     }
     o.push_str("</section>\n");

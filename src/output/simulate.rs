@@ -540,7 +540,7 @@ pub fn write_simulate(
     w.into_inner()
         .map_err(|e| OutputError::Io(std::io::Error::other(e.to_string())))?;
 
-    for f in super::figures::response_figures(s, r) {
+    for f in super::figures::response_figures(s, r, &sim.modes) {
         f.draw(dir)?;
     }
     if let Some(text) = super::hub::csv(sim) {

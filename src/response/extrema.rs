@@ -176,6 +176,28 @@ pub fn hermite_max(a: Knot, b: Knot) -> (f64, f64) {
     best
 }
 
+/// The interior critical points (t, H(t)) of the cubic Hermite interpolant through two
+/// knots (its local minima and maxima strictly inside the interval), and how many.
+pub fn hermite_critical(a: Knot, b: Knot) -> ([(f64, f64); 2], usize) {
+    let h = b.0 - a.0;
+    let mut out = [(0.0, 0.0); 2];
+    if h <= 0.0 {
+        return (out, 0);
+    }
+    let (v0, d0, v1, d1) = (a.1, a.2 * h, b.1, b.2 * h);
+    let c2 = 3.0 * (v1 - v0) - 2.0 * d0 - d1;
+    let c3 = 2.0 * (v0 - v1) + d0 + d1;
+    let (roots, count) = quadratic_roots(3.0 * c3, 2.0 * c2, d0);
+    let mut n = 0;
+    for &s in &roots[..count] {
+        if s > 0.0 && s < 1.0 {
+            out[n] = (a.0 + s * h, v0 + s * (d0 + s * (c2 + s * c3)));
+            n += 1;
+        }
+    }
+    (out, n)
+}
+
 /// The real roots of a x² + b x + c (of the linear equation when a = 0; none when both
 /// vanish), computed without cancellation: the roots and how many there are.
 fn quadratic_roots(a: f64, b: f64, c: f64) -> ([f64; 2], usize) {

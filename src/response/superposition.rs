@@ -337,6 +337,74 @@ impl ModalResponse {
         }
     }
 
+    /// Each channel's smallest and largest value in each of `columns` equal spans of
+    /// [0, duration], from the closed form — the grid's knots and their cubic Hermite
+    /// interpolants' extrema (within ~1e-3 of a mode's amplitude: a plot's resolution) — as
+    /// (t, v) points in time order: the min/max envelope a plot draws where the samples
+    /// would alias.
+    pub fn envelopes(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+        duration: f64,
+        columns: usize,
+    ) -> Vec<Vec<(f64, f64)>> {
+        let columns = columns.max(1);
+        let duration = duration.max(0.0);
+        let signals = self.signals(modal, channels);
+        let fastest = signals.iter().map(WaveSum::fastest).fold(0.0, f64::max);
+        let grid = extrema::grid(fastest, duration);
+        let empty = ((f64::NAN, f64::INFINITY), (f64::NAN, f64::NEG_INFINITY));
+        let mut env = vec![vec![empty; columns]; channels.len()];
+        let column = |t: f64| {
+            if duration > 0.0 {
+                ((t / duration * columns as f64) as usize).min(columns - 1)
+            } else {
+                0
+            }
+        };
+        let mut last: Vec<Option<extrema::Knot>> = vec![None; channels.len()];
+        self.on_grid(modal, channels, &grid, &mut |times, values, slopes| {
+            for (c, (e, prev)) in env.iter_mut().zip(&mut last).enumerate() {
+                for (i, &t) in times.iter().enumerate() {
+                    let knot = (t, values[(i, c)], slopes[(i, c)]);
+                    let mut offer = |(t, v): (f64, f64)| {
+                        let slot = &mut e[column(t)];
+                        if v < slot.0 .1 {
+                            slot.0 = (t, v);
+                        }
+                        if v > slot.1 .1 {
+                            slot.1 = (t, v);
+                        }
+                    };
+                    offer((t, knot.1));
+                    if let Some(a) = *prev {
+                        if t > a.0 {
+                            let (pts, n) = extrema::hermite_critical(a, knot);
+                            pts[..n].iter().for_each(|p| offer(*p));
+                        }
+                    }
+                    *prev = Some(knot);
+                }
+            }
+        });
+        env.into_iter()
+            .map(|cols| {
+                let mut pts = Vec::with_capacity(2 * columns);
+                for (lo, hi) in cols {
+                    if lo.1.is_finite() && hi.1.is_finite() {
+                        let (a, b) = if lo.0 <= hi.0 { (lo, hi) } else { (hi, lo) };
+                        pts.push(a);
+                        if b != a {
+                            pts.push(b);
+                        }
+                    }
+                }
+                pts
+            })
+            .collect()
+    }
+
     /// The largest |value| of every channel on [0, duration] and its time, and the largest
     /// magnitude √(Σ v_c²) of every group of channels (a force's or a moment's components),
     /// exact to [`extrema::TOLERANCE`] of the channel's scale at any output rate
