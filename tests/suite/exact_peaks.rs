@@ -179,3 +179,54 @@ fn seed_peaks_do_not_move_with_the_output_rate() {
         }
     }
 }
+
+#[test]
+fn the_envelope_holds_every_sample_and_reaches_the_peak() {
+    // The seed's response at 50 Hz against modes up to 93 Hz: the figures' min/max envelope
+    // (from the solution) must hold every sample (the samples are the solution's values) and
+    // reach the closed-form peak to the interpolant's ~1e-3, never beyond it.
+    let sim = seed_at(1.0);
+    let r = sim.response.as_ref().unwrap();
+    let settings = scenario(SEED).response;
+    assert!(flexcraft::simulation::aliased(&r.modal, &settings).is_some());
+    let env = r
+        .modal
+        .envelopes(&sim.modes, &r.channels, settings.duration, 1999);
+    let largest = (0..r.channels.len())
+        .map(|c| r.history.peak(c).0)
+        .fold(0.0, f64::max);
+    for (c, ch) in r.channels.iter().enumerate() {
+        let pts = &env[c];
+        assert!(
+            pts.windows(2).all(|w| w[0].0 <= w[1].0),
+            "{}: not in time order",
+            ch.name
+        );
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                (a.min(p.1), b.max(p.1))
+            });
+        let peak = r.history.peak(c).0;
+        let floor = 1e-9 * largest;
+        for k in 0..r.history.times.len() {
+            let v = r.history.values[(k, c)];
+            assert!(
+                v <= hi + 1e-9 * peak + floor && v >= lo - 1e-9 * peak - floor,
+                "{}",
+                ch.name
+            );
+        }
+        let drawn = hi.abs().max(lo.abs());
+        assert!(
+            drawn <= peak * (1.0 + 1e-9) + floor,
+            "{}: {drawn} above {peak}",
+            ch.name
+        );
+        assert!(
+            drawn >= peak * (1.0 - 2e-3) - floor,
+            "{}: {drawn} vs {peak}",
+            ch.name
+        );
+    }
+}
