@@ -9,9 +9,10 @@
 //! through them would beat the peak so far, the vertex is a candidate
 //! ([`PeakTracker::resolve`]): the run evaluates the solution there from the step's dense
 //! output and narrows the bracket by successive parabolic interpolation, so that the peak
-//! is a value the solution attains, found to the dense output's accuracy and independent of
-//! the output samples (which are not observed). Without a dense output the vertex itself
-//! stands (error O(h³) for a smooth magnitude against O(h²) for the largest observation
+//! is a value the solution attains, found to the dense output's accuracy. The output samples
+//! are not observed, so no peak depends on them. Without a dense output the run trusts (the
+//! automatic integrator's, whose interpolant overshoots on the stiff parts it does not
+//! resolve) the vertex itself stands (error O(h³) for a smooth magnitude against O(h²) for the largest observation
 //! alone). A latch or a capture changes the loads abruptly; the run breaks the history
 //! there so that no parabola spans the jump.
 
