@@ -90,13 +90,7 @@ impl PeakTracker {
                 if v > best.0 {
                     *best = (v, ts);
                 }
-                let p = (ts, v);
-                tri = match (ts < tri[1].0, v >= tri[1].1) {
-                    (true, true) => [tri[0], p, tri[1]],
-                    (true, false) => [p, tri[1], tri[2]],
-                    (false, true) => [tri[1], p, tri[2]],
-                    (false, false) => [tri[0], tri[1], p],
-                };
+                tri = narrow(tri, (ts, v));
             }
         }
     }
@@ -114,6 +108,17 @@ impl PeakTracker {
     /// The peak of every magnitude, (value, time).
     pub fn peaks(&self) -> &[Peak] {
         &self.best
+    }
+}
+
+/// The bracket (t₀ < t₁ < t₂, the middle highest) with a new point p inside it: the three
+/// points that keep the highest in the middle (successive parabolic interpolation).
+pub fn narrow(tri: [(f64, f64); 3], p: (f64, f64)) -> [(f64, f64); 3] {
+    match (p.0 < tri[1].0, p.1 >= tri[1].1) {
+        (true, true) => [tri[0], p, tri[1]],
+        (true, false) => [p, tri[1], tri[2]],
+        (false, true) => [tri[1], p, tri[2]],
+        (false, false) => [tri[0], tri[1], p],
     }
 }
 

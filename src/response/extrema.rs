@@ -451,22 +451,19 @@ pub fn grid(fastest: f64, t_end: f64) -> Vec<f64> {
 /// The largest |v| on [0, t_end] and its time, evaluating the grid in closed form (one
 /// signal; [`PeakSearch`] fed in bulk when many signals share a grid).
 pub fn peak(v: &WaveSum, t_end: f64) -> (f64, f64) {
-    let mut search = PeakSearch::new(Scalar::new(v, t_end));
-    let knots: Vec<Knot> = grid(v.fastest(), t_end)
-        .into_iter()
-        .map(|t| {
-            let (g, dg) = search.objective().at(t);
-            (t, g, dg)
-        })
-        .collect();
-    search.feed(&knots);
-    search.finish()
+    search_on_grid(Scalar::new(v, t_end), v.fastest(), t_end)
 }
 
 /// The largest magnitude √(Σ v_c²) of a vector of signals on [0, t_end] and its time.
 pub fn norm_peak(vs: &[&WaveSum], t_end: f64) -> (f64, f64) {
     let fastest = vs.iter().map(|v| v.fastest()).fold(0.0, f64::max);
-    let mut search = PeakSearch::new(SquaredNorm::new(vs, t_end));
+    let (g, t) = search_on_grid(SquaredNorm::new(vs, t_end), fastest, t_end);
+    (g.sqrt(), t)
+}
+
+/// [`PeakSearch`] of `g` fed the [`grid`] for `fastest` on [0, t_end] in closed form.
+fn search_on_grid<O: Objective>(g: O, fastest: f64, t_end: f64) -> (f64, f64) {
+    let mut search = PeakSearch::new(g);
     let knots: Vec<Knot> = grid(fastest, t_end)
         .into_iter()
         .map(|t| {
@@ -475,8 +472,7 @@ pub fn norm_peak(vs: &[&WaveSum], t_end: f64) -> (f64, f64) {
         })
         .collect();
     search.feed(&knots);
-    let (g, t) = search.finish();
-    (g.sqrt(), t)
+    search.finish()
 }
 
 #[cfg(test)]

@@ -8,7 +8,8 @@
 //! With r(x) the undeformed position of the station x, J_u(x) and J_θ(x) the Jacobians of
 //! its displacement and small rotation ([`crate::ritz::shapes::BeamStation`]), ρA the line
 //! mass and ρI_p the polar inertia per length, and M_D the mass matrix of the components
-//! hanging on the beam at or beyond x ([`RitzModel::partial_mass`]):
+//! hanging on the beam at or beyond x ([`RitzModel::partial_mass`],
+//! [`Structure::hanging_station`]):
 //!
 //!   p = ∫_x^L ρA J_u dx q̇ + M_D[0..3,:] q̇,
 //!   H_c = ∫_x^L [ρA (r − c) × J_u + ρI_p eₓ (eₓ·J_θ)] dx q̇ + M_D[3..6,:] q̇,
@@ -26,7 +27,7 @@ use crate::basis::Quadrature;
 use crate::math::Vec3;
 use crate::ritz::shapes::{attachment_of, BeamStation};
 use crate::ritz::RitzModel;
-use crate::structure::{Attachment, ComponentId, Structure};
+use crate::structure::{ComponentId, Structure};
 
 /// The six stress resultants' names, units and labels, in the order of [`section_channels`].
 pub const RESULTANTS: [(&str, &str); 6] = [
@@ -37,25 +38,6 @@ pub const RESULTANTS: [(&str, &str); 6] = [
     ("My", "N·m"),
     ("Mz", "N·m"),
 ];
-
-/// The station x (m from the root) on beam `beam` where component `id` hangs on it through
-/// its chain of parents; None if it does not hang on the beam (or is the beam).
-pub fn hanging_station(st: &Structure, id: ComponentId, beam: usize) -> Option<f64> {
-    let mut att = match id {
-        ComponentId::Hub => return None,
-        ComponentId::Beam(i) if i == beam => return None,
-        ComponentId::Beam(i) => &st.beams[i].attachment,
-        ComponentId::Plate(i) => &st.plates[i].attachment,
-        ComponentId::Mass(i) => &st.masses[i].attachment,
-    };
-    loop {
-        match att {
-            Attachment::Hub { .. } => return None,
-            Attachment::Beam { beam: b, station } if *b == beam => return Some(*station),
-            Attachment::Beam { beam: b, .. } => att = &st.beams[*b].attachment,
-        }
-    }
-}
 
 /// The stations of beam `beam` where its section loads are recovered: tenths of its length,
 /// root and tip included, and every station where something hangs on it (the inboard side,
@@ -68,7 +50,7 @@ pub fn stations(st: &Structure, beam: usize) -> Vec<f64> {
         .chain((0..st.plates.len()).map(ComponentId::Plate))
         .chain((0..st.masses.len()).map(ComponentId::Mass));
     for id in ids {
-        if let Some(x) = hanging_station(st, id, beam) {
+        if let Some(x) = st.hanging_station(id, beam) {
             out.push(x.clamp(0.0, l));
         }
     }
@@ -128,8 +110,10 @@ pub fn section_channels(model: &RitzModel, beam: usize, x: f64) -> Vec<Channel> 
         }
     }
     // What hangs on the beam at or beyond x.
-    let beyond =
-        |id: ComponentId| hanging_station(st, id, beam).is_some_and(|s| s >= x - 1e-12 * b.length);
+    let beyond = |id: ComponentId| {
+        st.hanging_station(id, beam)
+            .is_some_and(|s| s >= x - 1e-12 * b.length)
+    };
     if (0..st.beams.len())
         .map(ComponentId::Beam)
         .chain((0..st.plates.len()).map(ComponentId::Plate))

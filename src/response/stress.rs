@@ -365,13 +365,7 @@ fn refine_max(f: &dyn Fn(f64) -> f64, a: (f64, f64), m: (f64, f64), b: (f64, f64
         if v > best.0 {
             best = (v, ts);
         }
-        let p = (ts, v);
-        tri = match (ts < tri[1].0, v >= tri[1].1) {
-            (true, true) => [tri[0], p, tri[1]],
-            (true, false) => [p, tri[1], tri[2]],
-            (false, true) => [tri[1], p, tri[2]],
-            (false, false) => [tri[0], tri[1], p],
-        };
+        tri = crate::deploy::peaks::narrow(tri, (ts, v));
     }
     best
 }

@@ -217,18 +217,24 @@ impl Structure {
 
     /// Component `id` is beam `root`, or hangs on it through any chain of parents.
     pub fn in_subtree(&self, id: ComponentId, root: usize) -> bool {
+        id == ComponentId::Beam(root) || self.hanging_station(id, root).is_some()
+    }
+
+    /// The station (m from its root) at which component `id` hangs on beam `beam` through
+    /// its chain of parents; None if it does not hang on the beam (or is the beam).
+    pub fn hanging_station(&self, id: ComponentId, beam: usize) -> Option<f64> {
         let mut att = match id {
-            ComponentId::Hub => return false,
-            ComponentId::Beam(i) if i == root => return true,
+            ComponentId::Hub => return None,
+            ComponentId::Beam(i) if i == beam => return None,
             ComponentId::Beam(i) => &self.beams[i].attachment,
             ComponentId::Plate(i) => &self.plates[i].attachment,
             ComponentId::Mass(i) => &self.masses[i].attachment,
         };
         loop {
             match att {
-                Attachment::Hub { .. } => return false,
-                Attachment::Beam { beam, .. } if *beam == root => return true,
-                Attachment::Beam { beam, .. } => att = &self.beams[*beam].attachment,
+                Attachment::Hub { .. } => return None,
+                Attachment::Beam { beam: b, station } if *b == beam => return Some(*station),
+                Attachment::Beam { beam: b, .. } => att = &self.beams[*b].attachment,
             }
         }
     }
