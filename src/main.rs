@@ -461,7 +461,8 @@ fn run_simulate(
     if fail_on_negative_margin {
         let negative: Vec<_> = output::margins::margins(&scenario, &sim)
             .into_iter()
-            .filter(|m| m.margin < 0.0)
+            // A margin that is not a number fails too.
+            .filter(|m| m.margin < 0.0 || m.margin.is_nan())
             .collect();
         for m in &negative {
             eprintln!(

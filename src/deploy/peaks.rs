@@ -2,19 +2,19 @@
 //!
 //! A latch-up load peaks within a fraction of the latch's period, which the output rate
 //! need not resolve, so the run observes every tracked magnitude at every accepted step's
-//! end (the explicit and implicit integrators resolve the motion there; the adiabatic one,
-//! whose steps do not resolve the ringing, adds points inside its steps during a latch-up,
-//! `super::run`) and at every sample and event. Where the
-//! three latest observations of a magnitude rise and fall and the vertex of the parabola
-//! through them would beat the peak so far, the vertex is a candidate
-//! ([`PeakTracker::resolve`]): the run evaluates the solution there from the step's dense
-//! output and narrows the bracket by successive parabolic interpolation, so that the peak
-//! is a value the solution attains, found to the dense output's accuracy. The output samples
-//! are not observed, so no peak depends on them. Without a dense output the run trusts (the
-//! automatic integrator's, whose interpolant overshoots on the stiff parts it does not
-//! resolve) the vertex itself stands (error O(h³) for a smooth magnitude against O(h²) for the largest observation
-//! alone). A latch or a capture changes the loads abruptly; the run breaks the history
-//! there so that no parabola spans the jump.
+//! end and at every event — never at the output samples, so that no peak depends on them —
+//! and, with the named integrators, inside the steps too (each step's midpoint; the
+//! adiabatic one, whose steps do not resolve the ringing, more points during a latch-up:
+//! `super::run`). Where the three latest observations of a magnitude rise and fall and the
+//! vertex of the parabola through them would beat the peak so far, the vertex is a
+//! candidate ([`PeakTracker::resolve`]): the run evaluates the solution there from the
+//! step's dense output and narrows the bracket by successive parabolic interpolation, so
+//! that the peak is a value the solution attains, to the dense output's accuracy. Where the
+//! run has no interpolant it trusts (the automatic integrator, whose interpolant overshoots
+//! on the stiff parts it lets follow quasi-statically), the vertex stands, capped (error
+//! O(h³) for a smooth magnitude against O(h²) for the largest observation alone). A latch
+//! or a capture changes the loads abruptly; the run breaks the history there so that no
+//! parabola spans the jump.
 
 /// A peak magnitude and its time (s from release).
 pub type Peak = (f64, f64);
@@ -84,7 +84,15 @@ impl PeakTracker {
                     break;
                 }
                 let Some(v) = eval(ts).and_then(|m| m.get(i).copied()) else {
-                    *best = (vs, ts);
+                    // The vertex stands, capped: for evenly spaced points it rises at most
+                    // (v₁ − min(v₀, v₂))/8 above the middle one; unevenly spaced points can
+                    // put it far above every observation (3.25 from 0, 1, 0.9 at 0, 1,
+                    // 1.01), so it is held to twice that.
+                    let low = tri[0].1.min(tri[2].1);
+                    let vs = vs.min(tri[1].1 + 0.25 * (tri[1].1 - low));
+                    if vs > best.0 {
+                        *best = (vs, ts);
+                    }
                     break;
                 };
                 if v > best.0 {

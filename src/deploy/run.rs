@@ -943,7 +943,6 @@ impl<'a, E: Engine> Run<'a, E> {
         if !self.resolved {
             self.peaks.break_history();
             self.latch_up_peaks.break_history();
-            self.latch_up_peaks.break_history();
         }
         self.peaks.observe(t, m);
         if self.last_event.is_finite() {

@@ -88,10 +88,21 @@ pub fn timeline(sim: &Simulation) -> Option<Vec<HubRow>> {
         .iter()
         .map(WaveSum::derivative)
         .collect();
-    let q_h = attitude::from_rotation_vector(h.rotation);
+    // With rigid latches the hand-over is the last latch, whose sample is the last row; with
+    // compliant ones it is the settling's end, after the last sample by up to one output
+    // period Δ: the hub's state there to first order in Δ (its velocity and rate carried).
+    let gap = (th - h.t).max(0.0);
+    let q_h = attitude::product(
+        attitude::from_rotation_vector(h.rate * gap),
+        attitude::from_rotation_vector(h.rotation),
+    );
     let r_h = attitude::matrix(q_h);
+    let h = HubRow {
+        position: h.position + h.velocity * gap,
+        ..h
+    };
     for (k, &t) in r.history.times.iter().enumerate() {
-        if k == 0 {
+        if k == 0 && gap == 0.0 {
             // The hand-over instant is the deployment's last row.
             continue;
         }

@@ -111,6 +111,9 @@ impl WaveSum {
     }
 }
 
+/// The kept intervals' count at which a search first drops those the best has overtaken.
+const PRUNE_AT: usize = 4096;
+
 /// The relative tolerance of [`peak`], against [`WaveSum::scale`].
 pub const TOLERANCE: f64 = 1e-10;
 
@@ -324,6 +327,10 @@ pub struct PeakSearch<O> {
     /// Intervals that might hold a larger value: (interpolated estimate, M₄ from their
     /// piece's start on, ends).
     open: Vec<(f64, f64, Knot, Knot)>,
+    /// `open`'s length at which it is pruned next (twice what the last pruning left, so
+    /// that pruning costs O(1) per interval even when most intervals stay: an undamped
+    /// single mode's every crest).
+    prune_at: usize,
 }
 
 impl<O: Objective> PeakSearch<O> {
@@ -338,6 +345,7 @@ impl<O: Objective> PeakSearch<O> {
             },
             last: None,
             open: Vec::new(),
+            prune_at: PRUNE_AT,
         }
     }
 
@@ -374,8 +382,9 @@ impl<O: Objective> PeakSearch<O> {
         }
         if est + bound > self.best.value + self.floor {
             self.open.push((est, fourth, a, b));
-            if self.open.len() > 4096 {
+            if self.open.len() > self.prune_at {
                 self.prune();
+                self.prune_at = PRUNE_AT.max(2 * self.open.len());
             }
         }
     }
@@ -415,7 +424,8 @@ fn refine(
     if est + bound <= best.value + floor {
         return;
     }
-    if bound <= floor || depth >= MAX_DEPTH {
+    // The leaf's value is within 2·bound of the interval's maximum.
+    if 2.0 * bound <= floor || depth >= MAX_DEPTH {
         best.offer(at, g.at(at).0);
         return;
     }

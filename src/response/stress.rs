@@ -212,6 +212,8 @@ pub fn peak_von_mises(
     let mut intervals: Vec<Vec<(f64, f64, Knot, Knot)>> = vec![Vec::new(); count];
     let mut best_estimate = vec![0.0_f64; count];
     let mut last: Vec<Option<Knot>> = vec![None; count];
+    // Each list is pruned when it doubles what the last pruning left (O(1) per interval).
+    let mut prune_at = vec![4096_usize; count];
     response.on_grid(modal, channels, &grid, &mut |times, values, slopes| {
         for k in 0..count {
             let (list, best, prev) = (&mut intervals[k], &mut best_estimate[k], &mut last[k]);
@@ -229,9 +231,10 @@ pub fn peak_von_mises(
                         if est >= (1.0 - REFINE_WINDOW) * *best {
                             *best = best.max(est);
                             list.push((est, where_, a, knot));
-                            if list.len() > 4096 {
+                            if list.len() > prune_at[k] {
                                 let floor = (1.0 - REFINE_WINDOW) * *best;
                                 list.retain(|x| x.0 >= floor);
+                                prune_at[k] = 4096.max(2 * list.len());
                             }
                         }
                     }

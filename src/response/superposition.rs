@@ -594,7 +594,7 @@ impl ResponseHistory {
     }
 
     /// Largest |value| of channel c among the samples, and its time (what a plot of the
-    /// samples shows; never above [`Self::peak`]).
+    /// samples shows; never above [`Self::peak`] beyond its tolerance).
     pub fn sampled_peak(&self, c: usize) -> (f64, f64) {
         let mut best = (0.0, 0.0);
         for (k, &t) in self.times.iter().enumerate() {
