@@ -62,6 +62,34 @@ pub fn stations(st: &Structure, beam: usize) -> Vec<f64> {
 /// The six stress resultants (N, V_y, V_z, T, M_y, M_z: [`RESULTANTS`]) at station `x` of
 /// beam `beam` as acceleration channels (module doc), named `<beam>@<x>_<resultant>`.
 pub fn section_channels(model: &RitzModel, beam: usize, x: f64) -> Vec<Channel> {
+    beam_section_channels(model, beam, &[x])
+}
+
+/// [`section_channels`] at every station of `xs`, six channels each in their order: the
+/// attachment's motion per coordinate, which the stations share, computed once.
+pub fn beam_section_channels(model: &RitzModel, beam: usize, xs: &[f64]) -> Vec<Channel> {
+    let mut unit = vec![0.0; model.dof()];
+    let attachments: Vec<(Vec3, Vec3)> = (0..unit.len())
+        .map(|j| {
+            unit[j] = 1.0;
+            let a = attachment_of(model, ComponentId::Beam(beam), &unit)
+                .unwrap_or((Vec3::ZERO, Vec3::ZERO));
+            unit[j] = 0.0;
+            a
+        })
+        .collect();
+    xs.iter()
+        .flat_map(|&x| station_channels(model, beam, x, &attachments))
+        .collect()
+}
+
+/// The six channels at station x, given the attachment's motion for each unit coordinate.
+fn station_channels(
+    model: &RitzModel,
+    beam: usize,
+    x: f64,
+    attachments: &[(Vec3, Vec3)],
+) -> Vec<Channel> {
     let st = &model.structure;
     let b = &st.beams[beam];
     let n = model.dof();
@@ -81,15 +109,6 @@ pub fn section_channels(model: &RitzModel, beam: usize, x: f64) -> Vec<Channel> 
     let q = Quadrature::gauss(terms + 24);
     let span = b.length - x;
     let mut unit = vec![0.0; n];
-    let attachments: Vec<(Vec3, Vec3)> = (0..n)
-        .map(|j| {
-            unit[j] = 1.0;
-            let a = attachment_of(model, ComponentId::Beam(beam), &unit)
-                .unwrap_or((Vec3::ZERO, Vec3::ZERO));
-            unit[j] = 0.0;
-            a
-        })
-        .collect();
     if span > 0.0 {
         for (&t, &w) in q.points.iter().zip(&q.weights) {
             let xg = x + span * t;

@@ -323,10 +323,7 @@ pub fn beam_stresses(
             continue;
         };
         let xs = super::sections::stations(st, i);
-        let channels: Vec<Channel> = xs
-            .iter()
-            .flat_map(|&x| super::sections::section_channels(model, i, x))
-            .collect();
+        let channels = super::sections::beam_section_channels(model, i, &xs);
         let peaks = peak_von_mises(response, modes, &channels, &b.section, &fibres, duration);
         let stations = xs.into_iter().zip(peaks).collect();
         out.push(BeamStresses {
