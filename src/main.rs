@@ -340,7 +340,7 @@ fn run_modes(c: &Common, sweep: Option<usize>) -> Result<(), ExitCode> {
 fn run_export(c: &Common) -> Result<(), ExitCode> {
     use flexcraft::export::ExportModel;
     let (path, json, out) = (c.scenario.as_path(), c.json, c.out.as_deref());
-    let scenario = load(c, RunParts::MODES)?;
+    let scenario = load(c, RunParts::EXPORT)?;
     let staged = prepare(out, c.force, &[c.scenario.as_path()])?;
     let model = RitzModel::assemble(&scenario.structure);
     let wanted = scenario.export_modes();

@@ -30,6 +30,7 @@ mod suite {
     pub mod hinge_closed_forms;
     pub mod implicit;
     pub mod independent_truths;
+    pub mod memory_estimate;
     pub mod modal_properties;
     pub mod montecarlo;
     pub mod mutations;

@@ -2,22 +2,31 @@
 //! scenario alone, so that a run that would exhaust the machine is refused with a location
 //! instead of dying in an allocation half-way (docs/scenario.md, "Limits").
 //!
-//! The model (measured on the seed structure with plate terms 20×20 … 40×40, peak resident
-//! memory of `flexcraft modes` ≈ 18–20 · 8n² bytes for n generalized coordinates): the
-//! assembly and the generalized eigen-solve hold about [`MATRICES_PER_SOLVE`] dense n × n
-//! matrices at once. Time series cost 8 bytes per number in memory, plus about
+//! The model (measured 2026-11-28 on the seed structure with plate terms 20×20, 30×30 and
+//! 40×40, n = 424, 924 and 1624 generalized coordinates: peak resident memory of
+//! `flexcraft modes` 98, 256 and 677 MiB, i.e. 54 MiB + 31 · 8n² bytes; `simulate` 2–5 %
+//! more): the assembly and the generalized eigen-solve hold about [`MATRICES_PER_SOLVE`]
+//! dense n × n matrices at once, and the program itself [`BASELINE_BYTES`]. The estimate is
+//! 1.15 times the measured peak there (`tests/suite/independent_truths.rs` measures it). Time series cost 8 bytes per number in memory, plus about
 //! [`CSV_BYTES_PER_NUMBER`] bytes of CSV text for the deployment's (the response's CSV is
 //! streamed to its file).
 
 use super::{Scenario, ScenarioError};
+use crate::deploy::base::BaseKind;
 use crate::structure::ComponentId;
 
 /// Dense n × n matrices alive at the peak of a modal solve (assembly, scaling, the Cholesky
 /// factor, the reduced problem, its eigenvectors, the back-transformed modes and the
-/// Rayleigh-quotient products), rounded up.
-pub const MATRICES_PER_SOLVE: u64 = 20;
+/// Rayleigh-quotient products): 31 measured, with a margin.
+pub const MATRICES_PER_SOLVE: u64 = 36;
 /// Bytes of CSV text per number written (`1.2345678901234567e-5,`), rounded up.
 pub const CSV_BYTES_PER_NUMBER: u64 = 24;
+/// The base modes the automatic deployment is guessed to keep (its cutoff is found at run
+/// time): the estimate's column count of deployment.csv (generated spacecraft keep 2 to 9).
+pub const DEPLOY_MODES_GUESS: u64 = 12;
+/// Bytes of NASA 42's flex file per pair of modes (the nine numbers of N_pq on three
+/// commented lines; measured 74 on a 418-mode plate model), rounded up.
+pub const FLEX_BYTES_PER_PAIR: u64 = 9 * 80;
 
 /// The default memory budget of a run: half of the memory this process may use — the
 /// machine's (Linux: MemTotal of /proc/meminfo) or, when lower, its control group's limit
@@ -54,8 +63,9 @@ fn cgroup_limit(text: &str) -> Option<u64> {
         .filter(|&b| b > 0 && b < 1 << 62)
 }
 
-/// Memory of the program itself, bytes.
-pub const BASELINE_BYTES: u64 = 32 << 20;
+/// Memory of the program itself (code, the scenario, the reports and figures of a small
+/// model), bytes: 54 MiB measured, with a margin.
+pub const BASELINE_BYTES: u64 = 64 << 20;
 
 /// The estimated cost of a run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -68,20 +78,25 @@ pub struct Estimate {
     pub deployment_cells: u64,
     /// Response samples × numbers per sample.
     pub response_cells: u64,
+    /// The export's model and files in memory (`flexcraft export`), bytes.
+    pub export_bytes: u64,
 }
 
 impl Estimate {
     /// Peak memory of the whole run, bytes: the modal solve, then the time series.
     pub fn peak_bytes(&self) -> u64 {
-        // The deployment's samples and its CSV text are held in memory together; the
-        // response's history is held as numbers and its CSV streamed to the file.
+        // The deployment's samples (of two runs at once while the automatic run compares a
+        // refinement with the run before it, and copied once for the outputs) and its CSV
+        // text are held in memory together; the response's history is held as numbers and
+        // its CSV streamed to the file.
         let series = self
             .deployment_cells
-            .saturating_mul(8 + CSV_BYTES_PER_NUMBER)
+            .saturating_mul(3 * 8 + CSV_BYTES_PER_NUMBER)
             .saturating_add(self.response_cells.saturating_mul(8));
         BASELINE_BYTES
             .saturating_add(self.modes_bytes)
             .saturating_add(series)
+            .saturating_add(self.export_bytes)
     }
 }
 
@@ -110,6 +125,8 @@ pub struct RunParts {
     pub deployment: bool,
     /// The response's time series.
     pub response: bool,
+    /// The export's model and files.
+    pub export: bool,
 }
 
 impl RunParts {
@@ -117,16 +134,25 @@ impl RunParts {
     pub const SIMULATE: Self = Self {
         deployment: true,
         response: true,
+        export: false,
     };
-    /// `modes`, `export`: the modal solve alone.
+    /// `modes`: the modal solve alone.
     pub const MODES: Self = Self {
         deployment: false,
         response: false,
+        export: false,
+    };
+    /// `export`: the modal solve and the exported model and files.
+    pub const EXPORT: Self = Self {
+        deployment: false,
+        response: false,
+        export: true,
     };
     /// `deploy`, `modes --deployment-sweep`: the modal solve and the deployment.
     pub const DEPLOY: Self = Self {
         deployment: true,
         response: false,
+        export: false,
     };
 }
 
@@ -146,9 +172,29 @@ impl Scenario {
         let deployment_cells =
             (self.deployment.as_ref().filter(|_| parts.deployment)).map_or(0, |d| {
                 let n = d.chain.len() as u64;
-                // t, α, α̇, hub (3 + 3), reactions (2N), moments (N), energies, hinge points
-                // (2(N + 1)): one sample, plus a copy at every latch.
-                let per_sample = 10 + 8 * n;
+                // The base's coordinates (every component but the deploying plate).
+                let base_dof = st.beams.iter().map(|b| b.terms.dof() as u64).sum::<u64>()
+                    + st.plates
+                        .iter()
+                        .filter(|p| p.name != d.plate)
+                        .map(|p| p.terms.dof() as u64)
+                        .sum::<u64>();
+                // The base's columns: every mode kept by `Flexible`, the count asked for (or,
+                // chosen automatically, about DEPLOY_MODES_GUESS) plus twelve correction
+                // vectors otherwise.
+                let base = match d.base {
+                    BaseKind::Rigid => 0,
+                    BaseKind::Flexible { modes: None } => base_dof,
+                    BaseKind::Flexible { modes: Some(m) } => m as u64,
+                    BaseKind::Corrected { modes } => modes as u64 + 12,
+                    BaseKind::Reduced { .. } => DEPLOY_MODES_GUESS + 12,
+                }
+                .min(base_dof);
+                // deployment.csv's columns: t, α, α̇ (2N), the hub (12), the base's columns,
+                // each beam's tip (4) and root loads (6), each hinge's reactions and latch
+                // moment (3N), the cable (N − 1), energies (3), momentum (6); one sample per
+                // row, plus a copy at every latch.
+                let per_sample = 21 + 6 * n + base + 10 * st.beams.len() as u64;
                 crate::response::rows(d.end_time, d.output_rate)
                     .saturating_add(2 * n)
                     .saturating_mul(per_sample)
@@ -159,9 +205,18 @@ impl Scenario {
             let panels = self.deployment.as_ref().map_or(0, |d| d.chain.len() as u64);
             let channels = 6 + 9 * st.beams.len() as u64 + 2 * st.plates.len() as u64 + panels;
             let modes = self.response.modes.map_or(dof, |m| (m as u64).min(dof));
+            // hub.csv (output/hub.rs): t, position, rotation, velocity and rate (13) per
+            // row, as numbers and as text held whole (CSV_BYTES_PER_NUMBER each): 13 · 4 in
+            // 8-byte cells.
+            let hub = 13 * (1 + CSV_BYTES_PER_NUMBER / 8);
             self.response
                 .rows()
-                .saturating_mul(1 + channels + 2 * modes)
+                .saturating_mul(1 + channels + 2 * modes + hub)
+        } else {
+            0
+        };
+        let export_bytes = if parts.export {
+            self.export_bytes(dof)
         } else {
             0
         };
@@ -170,7 +225,51 @@ impl Scenario {
             modes_bytes,
             deployment_cells,
             response_cells,
+            export_bytes,
         }
+    }
+
+    /// The export's memory beyond the modal solve for a model of `dof` coordinates, bytes:
+    /// the mass elements of 42's modal integrals (`export::mass_elements`: per point and kept
+    /// mode a translation and a rotation, held twice while the flex body is built, and once
+    /// more as the products' matrices), the integrals' N (nine numbers per pair of modes) and
+    /// the texts held whole until they are written (outputs appear whole or not at all), each
+    /// up to three times its length while it grows: the flex file (about
+    /// [`FLEX_BYTES_PER_PAIR`] per pair of modes) and the state-space model's JSON
+    /// ([`CSV_BYTES_PER_NUMBER`] per entry of its (2n)² A matrix, with the .mat and .npz
+    /// beside it).
+    fn export_bytes(&self, dof: u64) -> u64 {
+        let st = &self.structure;
+        let elastic = dof.saturating_sub(6);
+        let modes = self
+            .export_modes()
+            .map_or(elastic, |m| (m as u64).min(elastic));
+        // Points of the export's quadrature (export/mass.rs: terms + 4 per direction).
+        let points = 1
+            + st.masses.len() as u64
+            + st.beams
+                .iter()
+                .map(|b| {
+                    let t = b.terms;
+                    t.bending.max(t.torsion).max(t.axial) as u64 + 4
+                })
+                .sum::<u64>()
+            + st.plates
+                .iter()
+                .map(|p| (p.terms.length as u64 + 4) * (p.terms.width as u64 + 4))
+                .sum::<u64>();
+        let elements = points.saturating_mul(modes).saturating_mul(3 * 48 + 24);
+        let pairs = modes.saturating_mul(modes);
+        let integrals = pairs.saturating_mul(9 * 8);
+        let flex = pairs.saturating_mul(3 * FLEX_BYTES_PER_PAIR);
+        let states = 2 * (modes + 6);
+        let model = states
+            .saturating_mul(states)
+            .saturating_mul(3 * CSV_BYTES_PER_NUMBER + 2 * 8);
+        elements
+            .saturating_add(integrals)
+            .saturating_add(flex)
+            .saturating_add(model)
     }
 
     /// Refuses a run whose estimated peak memory exceeds `max_bytes`, located at the key

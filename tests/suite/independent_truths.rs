@@ -136,6 +136,82 @@ fn ritz_hub_mass_block_matches_the_independent_integration() {
     }
 }
 
+/// NASA 42's mass elements (`export::mass_elements`: quadrature points of every beam and plate,
+/// the hub and the lumped bodies, each with its mass and own inertia) summed into the whole
+/// spacecraft's mass, centre of mass and inertia about it, against the Python integration:
+/// the same tolerances as [`structure_mass_properties_match_the_independent_integration`].
+/// The examples hold every kind of element: beams on the hub and on a beam (full), plates on
+/// a beam, lumped masses with products of inertia. A plate or a beam left out, a quadrature
+/// weight off, a line inertia about the wrong axis is caught.
+#[test]
+fn export_mass_elements_match_the_independent_integration() {
+    use flexcraft::math::{Mat3, Vec3};
+    for (name, truth, s) in mass_property_examples() {
+        let model = RitzModel::assemble(&s.structure);
+        let elements = flexcraft::export::mass_elements(&model, &[]);
+        let mass: f64 = elements.iter().map(|e| e.mass).sum();
+        let first = elements
+            .iter()
+            .fold(Vec3::ZERO, |a, e| a + e.position * e.mass);
+        // Inertia about the origin: each element's own plus m(|r|² I − r rᵀ).
+        let steiner = |r: Vec3, m: f64| (Mat3::IDENTITY * r.dot(r) - r.outer(r)) * m;
+        let j_o = elements.iter().fold(Mat3::default(), |a, e| {
+            a + e.inertia + steiner(e.position, e.mass)
+        });
+        let c = first * (1.0 / mass);
+        let j_cm = j_o - steiner(c, mass);
+        let m = truth.get("mass").num();
+        let tc = truth.get("center_of_mass").nums();
+        let j = truth.get("inertia_cm").matrix();
+        let trace = j[0][0] + j[1][1] + j[2][2];
+        let gyration = (trace / m).sqrt();
+        check(&format!("{name} elements' mass"), mass, m, m, MASS_TOL);
+        for i in 0..3 {
+            let what = format!("{name} elements' centre of mass [{i}]");
+            check(&what, c.get(i), tc[i], gyration, MASS_TOL);
+            for k in 0..3 {
+                let what = format!("{name} elements' inertia about the centre of mass [{i}][{k}]");
+                check(&what, j_cm.get(i, k), j[i][k], trace, MASS_TOL);
+            }
+        }
+    }
+}
+
+/// The same elements carry the Ritz model's kinetic energy in every hub-fixed mode (the
+/// module's claim): Σ_e m_e ψ_p·ψ_q + θ_p·I_e θ_q, a quadrature of the continuum that samples
+/// the shapes point by point (attachments' motion included), must be δ_pq for the mass-
+/// normalised hub-fixed modes of the full example (beams on a beam, plate on a beam, lumped
+/// bodies), which come from the assembled mass matrix (Gauss rules of the basis products). To
+/// 1e-9: both are exact for the polynomial basis, the rest is the eigen-solver's orthonormality.
+#[test]
+fn export_mass_elements_carry_the_modes_kinetic_energy() {
+    let (_, _, s) = mass_property_examples()
+        .into_iter()
+        .find(|(n, _, _)| n == "full.toml")
+        .expect("full.toml in the fixture");
+    let model = RitzModel::assemble(&s.structure);
+    let modes = flexcraft::ModalAnalysis::compute_lowest(&model, Some(12)).expect("modes");
+    let shapes: Vec<&[f64]> = modes.hub_fixed.iter().map(|h| h.shape.as_slice()).collect();
+    assert!(shapes.len() >= 8, "{} hub-fixed modes", shapes.len());
+    let elements = flexcraft::export::mass_elements(&model, &shapes);
+    for p in 0..shapes.len() {
+        for q in 0..shapes.len() {
+            let sum: f64 = elements
+                .iter()
+                .map(|e| {
+                    let ((up, tp), (uq, tq)) = (e.motion[p], e.motion[q]);
+                    e.mass * up.dot(uq) + tp.dot(e.inertia.apply(tq))
+                })
+                .sum();
+            let want = if p == q { 1.0 } else { 0.0 };
+            assert!(
+                (sum - want).abs() <= 1e-9,
+                "modes {p}, {q}: Σ m ψ·ψ + θ·Iθ = {sum:e}, want {want}"
+            );
+        }
+    }
+}
+
 fn distribution(case: &Json) -> Distribution {
     let p = case.get("params").nums();
     match case.get("kind").str() {
