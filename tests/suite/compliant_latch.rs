@@ -183,6 +183,7 @@ fn the_default_settling_ends_when_the_latch_has_decayed_or_at_its_cap() {
 #[test]
 fn stiffer_latches_tend_to_the_plastic_impact() {
     let mut last = f64::INFINITY;
+    let mut last_excess = f64::INFINITY;
     for kl in [1e2_f64, 1e3, 1e4] {
         // ζ = c_L / (2 √(J k_L)) = 0.5 with J = I + m l²/4 = 40/3 kg·m².
         let cl = (40.0 / 3.0 * kl).sqrt();
@@ -218,6 +219,34 @@ fn stiffer_latches_tend_to_the_plastic_impact() {
             "k_L = {kl}: rate {}",
             end.rate[0]
         );
+        // The energy the latch took (the run's kinetic + hinge spring + latch spring energy
+        // at the capture less at the end): the damped oscillator dissipates all of its
+        // vibration about α_eq, ½ J ω₀² + ½ (k + k_L) (α_L − α_eq)², i.e. the plastic impact's
+        // loss ½ J ω₀² plus M² / (2 (k + k_L)), M = k (α_ref − α_L) the hinge spring's moment
+        // at the latch — an excess that vanishes as k_L grows. What is left of the vibration
+        // after eight seconds is below 1e-8 of it here (e^{−2ζω_n t}).
+        let energy = |s: &flexcraft::deploy::Sample| s.kinetic + s.spring + s.latch_energy;
+        let at_capture = r
+            .samples
+            .iter()
+            .find(|s| s.t >= r.captures[0].time)
+            .expect("a sample at the capture");
+        assert!((at_capture.t - r.captures[0].time).abs() < 1e-12);
+        let taken = energy(at_capture) - energy(end);
+        let w0 = r.captures[0].rates[0];
+        let plastic = 0.5 * j * w0 * w0;
+        let moment = h.stiffness * (h.reference_angle - h.latch_angle);
+        let excess = moment * moment / (2.0 * (h.stiffness + kl));
+        assert!(
+            (taken - (plastic + excess)).abs() <= 1e-8 * plastic,
+            "k_L = {kl}: the latch took {taken} J, closed form {} J (plastic {plastic}, excess {excess})",
+            plastic + excess
+        );
+        assert!(
+            taken / plastic - 1.0 < last_excess,
+            "k_L = {kl}: the excess over the plastic loss does not fall"
+        );
+        last_excess = taken / plastic - 1.0;
         last = off;
     }
 }
