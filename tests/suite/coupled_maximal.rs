@@ -133,7 +133,11 @@ fn the_oracles_own_functions_are_the_shifted_legendre_polynomials_times_the_clam
     let polys: [(fn(f64) -> f64, fn(f64) -> f64, fn(f64) -> f64); 4] = [
         (|_| 1.0, |_| 0.0, |_| 0.0),
         (|x| 2.0 * x - 1.0, |_| 2.0, |_| 0.0),
-        (|x| 6.0 * x * x - 6.0 * x + 1.0, |x| 12.0 * x - 6.0, |_| 12.0),
+        (
+            |x| 6.0 * x * x - 6.0 * x + 1.0,
+            |x| 12.0 * x - 6.0,
+            |_| 12.0,
+        ),
         (
             |x| 20.0 * x.powi(3) - 30.0 * x * x + 12.0 * x - 1.0,
             |x| 60.0 * x * x - 60.0 * x + 12.0,

@@ -1,6 +1,6 @@
 //! The memory estimate that refuses a run before it starts (`scenario/budget.rs`) against
 //! the memory the run really takes (issue 43): the peak resident set of the `flexcraft`
-//! process, read from the kernel when it ends (`wait4`'s `ru_maxrss`), for every part the
+//! process, read from the kernel when it ends (`ru_maxrss`), for every part the
 //! estimate models — a modal solve whose dense matrices dominate (a 30 × 30 plate: 924
 //! coordinates), the export's mass elements and 42 files, the deployment's time series and
 //! the response's.
@@ -10,32 +10,40 @@
 //! would fit, or that no longer models what dominates, fails). Measured 2026-11-28: estimates
 //! 1.15–1.6 times the peaks.
 
-use super::common::{bin, example, scratch};
+use super::common::{example, scratch};
 use flexcraft::scenario::RunParts;
 use flexcraft::Scenario;
 
 /// Runs `flexcraft ARGS` to completion and returns its peak resident memory, bytes.
+///
+/// Read through a small Python parent (`resource.getrusage(RUSAGE_CHILDREN).ru_maxrss`): a
+/// process started straight from this test binary would inherit its high-water mark, since
+/// Linux carries the exec'ing process's old peak over into the new image's (`exec_mmap`),
+/// and the test binary runs many other tests beside this one.
 fn peak_resident(args: &[&str]) -> u64 {
-    let child = bin()
+    const PARENT: &str = "import resource, subprocess, sys\n\
+r = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n\
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n\
+sys.exit(r.returncode)\n";
+    let exe = env!("CARGO_BIN_EXE_flexcraft");
+    let o = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(PARENT)
+        .arg(exe)
         .args(args)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .expect("flexcraft starts");
-    let pid = child.id() as libc::pid_t;
-    let mut status = 0;
-    // SAFETY: a zeroed rusage is a valid value of the plain C struct, and wait4 is given
-    // pointers to the two locals it fills; the child is ours and reaped here only.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let r = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
-    assert_eq!(r, pid, "wait4");
+        .output()
+        .expect("python3 runs (a fresh machine has Python 3.11)");
     assert!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "flexcraft {args:?} failed ({status})"
+        o.status.success(),
+        "flexcraft {args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
     );
-    std::mem::forget(child);
     // Linux reports ru_maxrss in KiB.
-    usage.ru_maxrss as u64 * 1024
+    let kib: u64 = String::from_utf8_lossy(&o.stdout)
+        .trim()
+        .parse()
+        .expect("a number of KiB");
+    kib * 1024
 }
 
 fn check(name: &str, edit: impl Fn(String) -> String, command: &str, parts: RunParts) {
