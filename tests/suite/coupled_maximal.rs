@@ -130,7 +130,9 @@ fn clamped_family(n: usize, power: i32, xi: f64) -> Vec<[f64; 3]> {
 /// written out.
 #[test]
 fn the_oracles_own_functions_are_the_shifted_legendre_polynomials_times_the_clamp() {
-    let polys: [(fn(f64) -> f64, fn(f64) -> f64, fn(f64) -> f64); 4] = [
+    // (P*, P*', P*'') of each degree.
+    type Poly = (fn(f64) -> f64, fn(f64) -> f64, fn(f64) -> f64);
+    let polys: [Poly; 4] = [
         (|_| 1.0, |_| 0.0, |_| 0.0),
         (|x| 2.0 * x - 1.0, |_| 2.0, |_| 0.0),
         (
