@@ -271,3 +271,40 @@ fn lowest_eigenpairs_agree_with_the_dense_solver() {
         }
     }
 }
+
+/// Every hub-fixed mode of a large, ill-conditioned model is M-orthonormal: the seed with a
+/// 30 × 30 Legendre plate (924 coordinates, all 918 hub-fixed modes by the dense route),
+/// max |ΦᵀMΦ − I| ≤ 1e-8 with the assembled mass matrix (measured 2.5e-9 on mode 786: the
+/// rounding of ΦᵀMΦ itself for the top modes of a mass matrix this ill-conditioned). NASA 42
+/// needs Mf = I of every exported mode (the export refuses above 1e-6); with one
+/// re-orthonormalisation step the top modes were off by 1.1e-5 and `flexcraft export` of
+/// this model failed.
+#[test]
+fn every_hub_fixed_mode_of_a_large_model_is_mass_orthonormal() {
+    let src = include_str!("../../examples/seed.toml").replace(
+        "terms = { length = 8, width = 6 }",
+        "terms = { length = 30, width = 30 }",
+    );
+    let (model, modes) = solve(&src);
+    let hf = &modes.hub_fixed;
+    assert!(hf.len() > 900, "{} hub-fixed modes", hf.len());
+    let n = model.dof();
+    let phi = faer::Mat::from_fn(n, hf.len(), |i, j| hf[j].shape[i]);
+    let e = phi.transpose() * (&model.mass * &phi);
+    let mut worst = (0.0_f64, 0, 0);
+    for j in 0..hf.len() {
+        for i in 0..hf.len() {
+            let d = (e[(i, j)] - if i == j { 1.0 } else { 0.0 }).abs();
+            if d > worst.0 {
+                worst = (d, i, j);
+            }
+        }
+    }
+    assert!(
+        worst.0 <= 1e-8,
+        "|ΦᵀMΦ − I| = {:e} at modes {} and {}",
+        worst.0,
+        worst.1,
+        worst.2
+    );
+}
