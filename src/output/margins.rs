@@ -158,12 +158,12 @@ pub fn stress_lines(o: &mut String, s: &Scenario, sim: &Simulation) {
         if let Some((x, p)) = b.worst() {
             let _ = writeln!(
                 o,
-                "  {:<28} σ_vm {:>11.4e} Pa at x = {x:.4} m, t = {:.3} s from release (σ {:.4e} Pa, τ {:.4e} Pa)",
+                "  {:<28} σ_vm {:>11} at x = {x:.4} m, t = {:.3} s from release (σ {}, τ {})",
                 b.name,
-                p.stresses.von_mises,
+                super::engineering(p.stresses.von_mises, "Pa"),
                 r.handover.latch_time + p.time,
-                p.stresses.normal,
-                p.stresses.shear
+                super::engineering(p.stresses.normal, "Pa"),
+                super::engineering(p.stresses.shear, "Pa")
             );
         }
     }
@@ -175,13 +175,11 @@ pub fn stress_lines(o: &mut String, s: &Scenario, sim: &Simulation) {
         };
         let _ = writeln!(
             o,
-            "  margin of safety {:<34} MS = {ms}{} ({:.4e} {} against {:.4e} {} / FS {})",
+            "  margin of safety {:<34} MS = {ms}{} ({} against {} / FS {})",
             m.component,
             if m.margin < 0.0 { "  NEGATIVE" } else { "" },
-            m.value,
-            m.unit,
-            m.allowable,
-            m.unit,
+            super::engineering(m.value, m.unit),
+            super::engineering(m.allowable, m.unit),
             m.factor_of_safety
         );
     }
@@ -209,12 +207,10 @@ pub fn margins_table(s: &Scenario, sim: &Simulation) -> String {
         };
         let _ = writeln!(
             o,
-            "<tr><td class=\"l\">{}</td><td>{:.4e} {}</td><td>{:.4e} {}</td><td>{}</td><td{cls}>{shown}</td><td>{:.3}</td></tr>",
+            "<tr><td class=\"l\">{}</td><td>{}</td><td>{}</td><td>{}</td><td{cls}>{shown}</td><td>{:.3}</td></tr>",
             super::names::html(&m.component),
-            m.value,
-            m.unit,
-            m.allowable,
-            m.unit,
+            super::engineering(m.value, m.unit),
+            super::engineering(m.allowable, m.unit),
             m.factor_of_safety,
             m.time
         );

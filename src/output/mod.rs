@@ -51,6 +51,40 @@ pub(crate) fn snap(v: f64, scale: f64) -> f64 {
     }
 }
 
+/// v in engineering notation with an SI prefix and four significant digits, for tables a
+/// person reads: 8.6954e4 Pa → "86.95 kPa", 1049.3 N·m → "1.049 kN·m", 2.5e-5 m → "25.00 µm".
+/// Zero is "0 unit"; a value that is not finite is "–"; beyond the prefixes (1e-12 … 1e12)
+/// the mantissa grows or shrinks.
+pub(crate) fn engineering(v: f64, unit: &str) -> String {
+    if !v.is_finite() {
+        return "–".into();
+    }
+    if v == 0.0 {
+        return format!("0 {unit}");
+    }
+    const PREFIXES: [&str; 9] = ["p", "n", "µ", "m", "", "k", "M", "G", "T"];
+    let group = |x: f64| ((x.abs().log10() / 3.0).floor() as i32).clamp(-4, 4);
+    let render = |g: i32| {
+        let m = v / 10f64.powi(3 * g);
+        let decimals = if m.abs() >= 100.0 {
+            1
+        } else if m.abs() >= 10.0 {
+            2
+        } else {
+            3
+        };
+        (format!("{m:.decimals$}"), m)
+    };
+    let mut g = group(v);
+    let (mut text, m) = render(g);
+    // 999.96 rounds to "1000.0": one group up.
+    if text.trim_start_matches('-').starts_with("1000") && g < 4 && m.abs() < 1000.0 {
+        g += 1;
+        text = render(g).0;
+    }
+    format!("{text} {}{unit}", PREFIXES[(g + 4) as usize])
+}
+
 /// v with `decimals` fixed decimals, never "-0.000…".
 pub(crate) fn fixed(v: f64, decimals: usize) -> String {
     let s = format!("{v:.decimals$}");

@@ -283,3 +283,17 @@ fn long_series_are_decimated_for_plots_but_not_for_csv() {
     assert!(svg.len() < 400_000, "{} bytes", svg.len());
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn engineering_notation_uses_si_prefixes_and_four_digits() {
+    use super::engineering;
+    assert_eq!(engineering(8.6954e4, "Pa"), "86.95 kPa");
+    assert_eq!(engineering(1049.3, "N·m"), "1.049 kN·m");
+    assert_eq!(engineering(2.5e-5, "m"), "25.00 µm");
+    assert_eq!(engineering(-3.3e8, "Pa"), "-330.0 MPa");
+    assert_eq!(engineering(999.96, "Pa"), "1.000 kPa");
+    assert_eq!(engineering(0.0, "Pa"), "0 Pa");
+    assert_eq!(engineering(f64::NAN, "Pa"), "–");
+    assert_eq!(engineering(7.0, "N"), "7.000 N");
+    assert_eq!(engineering(2e15, "Pa"), "2000.0 TPa");
+}
