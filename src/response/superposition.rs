@@ -261,23 +261,16 @@ impl ModalResponse {
         &self,
         modal: &ModalAnalysis,
         channels: &[Channel],
-        grid: &[f64],
+        grid: &extrema::Grid,
         f: &mut GridPiece<'_>,
     ) {
-        if grid.is_empty() {
-            return;
-        }
         let (gd, ga) = (
             self.gains(modal, channels, Order::Displacement),
             self.gains(modal, channels, Order::Acceleration),
         );
         let nm = self.modes.len();
         let zeta = self.damping_ratio;
-        let h = if grid.len() > 1 {
-            grid[1] - grid[0]
-        } else {
-            0.0
-        };
+        let h = grid.spacing();
         let chunk = PEAK_CHUNK.min(grid.len());
         let (mut e, mut ed, mut edd, mut eddd) = (
             Mat::<f64>::zeros(chunk, nm),
@@ -287,10 +280,11 @@ impl ModalResponse {
         );
         let mut values = Mat::<f64>::zeros(chunk, channels.len());
         let mut slopes = Mat::<f64>::zeros(chunk, channels.len());
-        let mut start = 0;
-        loop {
-            let end = (start + chunk - 1).min(grid.len() - 1);
+        let mut times = Vec::with_capacity(chunk);
+        for (start, end) in grid.pieces(chunk) {
             let rows = end - start + 1;
+            times.clear();
+            times.extend((start..=end).map(|k| grid.at(k)));
             // η, η̇, η̈ = −2ζωη̇ − ω²η and η⃛ = −2ζωη̈ − ω²η̇ of every mode at the piece's times.
             for (j, m) in self.modes.iter().enumerate() {
                 let w = if m.rigid { 0.0 } else { m.omega_rad_s };
@@ -304,7 +298,7 @@ impl ModalResponse {
                         .expect("a fresh Mat is column-major")
                         .as_slice_mut(),
                 );
-                fill_state(m, zeta, grid[start], h, &mut x[..rows], &mut xd[..rows]);
+                fill_state(m, zeta, grid.at(start), h, &mut x[..rows], &mut xd[..rows]);
                 for i in 0..rows {
                     let (x, xd) = (e[(i, j)], ed[(i, j)]);
                     let xdd = -2.0 * zeta * w * xd - w * w * x;
@@ -325,15 +319,7 @@ impl ModalResponse {
                     }
                 }
             }
-            f(
-                &grid[start..=end],
-                values.subrows(0, rows),
-                slopes.subrows(0, rows),
-            );
-            if end + 1 >= grid.len() {
-                break;
-            }
-            start = end;
+            f(&times, values.subrows(0, rows), slopes.subrows(0, rows));
         }
     }
 
