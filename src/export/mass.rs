@@ -10,7 +10,7 @@
 //! The rules are Gauss–Legendre with `terms + EXTRA` points along each direction: for the
 //! polynomial (Legendre) basis one rule over the component, exact (a bending function of the
 //! n-term family has degree n + 1, so a product of two times a coordinate has degree
-//! 2n + 3 < 2(n + EXTRA)); for the characteristic functions a composite rule of `PANELS` such
+//! 2n + 3 ≤ 2(n + EXTRA) − 1); for the characteristic functions a composite rule of `PANELS` such
 //! panels, accurate to rounding. One rule instead of four panels matters for a plate: 16 times
 //! fewer points, each carrying every kept mode's motion (a 40 × 40 plate exporting all its
 //! 1 618 modes held 2.4 GB of point motions with the composite rule).
@@ -27,6 +27,26 @@ use crate::structure::ComponentId;
 const PANELS: usize = 4;
 /// Points per panel beyond the component's term count.
 const EXTRA: usize = 4;
+
+/// The number of mass elements [`mass_elements`] makes for `st` (the memory estimate's count):
+/// the hub, the lumped masses, and each beam's and plate's quadrature points.
+pub fn element_count(st: &crate::structure::Structure) -> u64 {
+    let panels = if st.basis() == BasisKind::Legendre {
+        1
+    } else {
+        PANELS as u64
+    };
+    let points = |terms: usize| panels * (terms + EXTRA) as u64;
+    1 + st.masses.len() as u64
+        + st.beams
+            .iter()
+            .map(|b| points(b.terms.bending.max(b.terms.torsion).max(b.terms.axial)))
+            .sum::<u64>()
+        + st.plates
+            .iter()
+            .map(|p| points(p.terms.length) * points(p.terms.width))
+            .sum::<u64>()
+}
 
 /// One mass element of the discretised structure.
 #[derive(Debug, Clone, PartialEq)]

@@ -19,7 +19,7 @@
 pub mod mass;
 pub mod points;
 
-pub use mass::{mass_elements, MassElement};
+pub use mass::{element_count, mass_elements, MassElement};
 pub use points::{point_jacobian, point_motion, point_position, NamedPoint, PointLocation};
 
 use crate::math::Vec3;

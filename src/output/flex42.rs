@@ -696,7 +696,8 @@ fn add_point(out: &mut ModalIntegrals, point: &MassPoint) {
             }
         }
         // The rotary inertia's share of N and Mf (a quadrature point has none); N_qp = N_pqᵀ:
-        // computed for q ≥ p, mirrored exactly.
+        // computed for q ≥ p, mirrored exactly for q ≠ p (N_pp's own share is symmetric to
+        // rounding).
         if *jk == [[0.0; 3]; 3] {
             continue;
         }

@@ -63,25 +63,20 @@ pub(crate) fn engineering(v: f64, unit: &str) -> String {
         return format!("0 {unit}");
     }
     const PREFIXES: [&str; 9] = ["p", "n", "µ", "m", "", "k", "M", "G", "T"];
-    let group = |x: f64| ((x.abs().log10() / 3.0).floor() as i32).clamp(-4, 4);
-    let render = |g: i32| {
-        let m = v / 10f64.powi(3 * g);
-        let decimals = if m.abs() >= 100.0 {
-            1
-        } else if m.abs() >= 10.0 {
-            2
-        } else {
-            3
-        };
-        (format!("{m:.decimals$}"), m)
+    // Four significant digits, decided on the rounded mantissa (9.99996 is "10.00").
+    let significant = |x: f64| {
+        let f = 10f64.powf(3.0 - x.abs().log10().floor());
+        (x * f).round() / f
     };
-    let mut g = group(v);
-    let (mut text, m) = render(g);
-    // 999.96 rounds to "1000.0": one group up.
-    if text.trim_start_matches('-').starts_with("1000") && g < 4 && m.abs() < 1000.0 {
+    let mut g = ((v.abs().log10() / 3.0).floor() as i32).clamp(-4, 4);
+    let mut m = significant(v / 10f64.powi(3 * g));
+    // 999.96 rounds to 1000: one group up.
+    if m.abs() >= 1000.0 && g < 4 {
         g += 1;
-        text = render(g).0;
+        m = significant(v / 10f64.powi(3 * g));
     }
+    let decimals = (3 - m.abs().log10().floor() as i32).clamp(0, 3) as usize;
+    let text = format!("{m:.decimals$}");
     format!("{text} {}{unit}", PREFIXES[(g + 4) as usize])
 }
 

@@ -295,5 +295,8 @@ fn engineering_notation_uses_si_prefixes_and_four_digits() {
     assert_eq!(engineering(0.0, "Pa"), "0 Pa");
     assert_eq!(engineering(f64::NAN, "Pa"), "–");
     assert_eq!(engineering(7.0, "N"), "7.000 N");
-    assert_eq!(engineering(2e15, "Pa"), "2000.0 TPa");
+    assert_eq!(engineering(2e15, "Pa"), "2000 TPa");
+    assert_eq!(engineering(9.9996, "Pa"), "10.00 Pa");
+    assert_eq!(engineering(99.996, "Pa"), "100.0 Pa");
+    assert_eq!(engineering(1e-7, "Pa"), "100.0 nPa");
 }

@@ -71,8 +71,8 @@ pub fn generalized_symmetric(
     // Mass-normalise (φᵀMφ = 1), then steps of symmetric (Löwdin) re-orthonormalisation,
     // Φ ← Φ (I − ½E) with E = ΦᵀMΦ − I, each leaving O(E²) without favouring any mode. The
     // K-Cholesky route leaves the high modes M-orthogonal to ≈ 1e-10 on small models, where
-    // one step makes them orthonormal to rounding; on large ones far less (a 924-coordinate
-    // plate model: |E| = 3e-3 on its top modes, 1.1e-5 left after one step, and NASA 42's
+    // one step makes them orthonormal to rounding; on large ones far less (a 932-coordinate
+    // plate model of 932 coordinates: |E| = 3e-3 on its top modes, 1.1e-5 left after one step, and NASA 42's
     // export refused the modes as not mass-normalised), so the steps go on while the last
     // one started from |E| above 1e-7 (at most LOWDIN_STEPS).
     const LOWDIN_STEPS: usize = 4;

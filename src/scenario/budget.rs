@@ -3,11 +3,12 @@
 //! instead of dying in an allocation half-way (docs/scenario.md, "Limits").
 //!
 //! The model (measured 2026-11-28 on the seed structure with plate terms 20×20, 30×30 and
-//! 40×40, n = 424, 924 and 1624 generalized coordinates: peak resident memory of
-//! `flexcraft modes` 98, 256 and 677 MiB, i.e. 54 MiB + 31 · 8n² bytes; `simulate` 2–5 %
+//! 40×40, n = 432, 932 and 1632 generalized coordinates: peak resident memory of
+//! `flexcraft modes` 98, 256 and 677 MiB, i.e. 51 MiB + 31 · 8n² bytes; `simulate` 2–5 %
 //! more): the assembly and the generalized eigen-solve hold about [`MATRICES_PER_SOLVE`]
 //! dense n × n matrices at once, and the program itself [`BASELINE_BYTES`]. The estimate is
-//! 1.15 times the measured peak there (`tests/suite/independent_truths.rs` measures it). Time series cost 8 bytes per number in memory, plus about
+//! about 1.15 times the measured peak there (`tests/suite/memory_estimate.rs` measures
+//! it). Time series cost 8 bytes per number in memory, plus about
 //! [`CSV_BYTES_PER_NUMBER`] bytes of CSV text for the deployment's (the response's CSV is
 //! streamed to its file).
 
@@ -24,8 +25,8 @@ pub const CSV_BYTES_PER_NUMBER: u64 = 24;
 /// The base modes the automatic deployment is guessed to keep (its cutoff is found at run
 /// time): the estimate's column count of deployment.csv (generated spacecraft keep 2 to 9).
 pub const DEPLOY_MODES_GUESS: u64 = 12;
-/// Bytes of NASA 42's flex file per pair of modes (the nine numbers of N_pq on three
-/// commented lines; measured 74 on a 418-mode plate model), rounded up.
+/// Bytes of NASA 42's flex file per pair of modes (the nine numbers of N_pq on commented
+/// lines: measured 640–650 per pair, 74 per number, on 100- to 926-mode exports), rounded up.
 pub const FLEX_BYTES_PER_PAIR: u64 = 9 * 80;
 
 /// The default memory budget of a run: half of the memory this process may use — the
@@ -64,7 +65,7 @@ fn cgroup_limit(text: &str) -> Option<u64> {
 }
 
 /// Memory of the program itself (code, the scenario, the reports and figures of a small
-/// model), bytes: 54 MiB measured, with a margin.
+/// model), bytes: 51 MiB measured, with a margin.
 pub const BASELINE_BYTES: u64 = 64 << 20;
 
 /// The estimated cost of a run.
@@ -179,15 +180,19 @@ impl Scenario {
                         .filter(|p| p.name != d.plate)
                         .map(|p| p.terms.dof() as u64)
                         .sum::<u64>();
-                // The base's columns: every mode kept by `Flexible`, the count asked for (or,
-                // chosen automatically, about DEPLOY_MODES_GUESS) plus twelve correction
-                // vectors otherwise.
+                // The base's columns: every mode when no count is given, else the count asked
+                // for (or, chosen automatically, about DEPLOY_MODES_GUESS) plus at most twelve
+                // correction vectors.
+                // (The automatic run turns a given count into `Corrected`.)
                 let base = match d.base {
                     BaseKind::Rigid => 0,
                     BaseKind::Flexible { modes: None } => base_dof,
-                    BaseKind::Flexible { modes: Some(m) } => m as u64,
-                    BaseKind::Corrected { modes } => modes as u64 + 12,
-                    BaseKind::Reduced { .. } => DEPLOY_MODES_GUESS + 12,
+                    BaseKind::Flexible { modes: Some(m) } | BaseKind::Corrected { modes: m } => {
+                        m as u64 + 12
+                    }
+                    BaseKind::Reduced { at_least, .. } => {
+                        DEPLOY_MODES_GUESS.max(at_least as u64) + 12
+                    }
                 }
                 .min(base_dof);
                 // deployment.csv's columns: t, α, α̇ (2N), the hub (12), the base's columns,
@@ -209,9 +214,11 @@ impl Scenario {
             // row, as numbers and as text held whole (CSV_BYTES_PER_NUMBER each): 13 · 4 in
             // 8-byte cells.
             let hub = 13 * (1 + CSV_BYTES_PER_NUMBER / 8);
+            // The history's numbers are counted one and a half times: its vectors grow by
+            // doubling (measured: the response part alone was within 3 % of one times).
             self.response
                 .rows()
-                .saturating_mul(1 + channels + 2 * modes + hub)
+                .saturating_mul(3 * (1 + channels + 2 * modes) / 2 + hub)
         } else {
             0
         };
@@ -231,8 +238,9 @@ impl Scenario {
 
     /// The export's memory beyond the modal solve for a model of `dof` coordinates, bytes:
     /// the mass elements of 42's modal integrals (`export::mass_elements`: per point and kept
-    /// mode a translation and a rotation, held twice while the flex body is built, and once
-    /// more as the products' matrices), the integrals' N (nine numbers per pair of modes) and
+    /// mode a translation and a rotation, 48 bytes, held three times — the elements, the
+    /// flex body's points and the growth of their vectors — and 24 bytes more as the
+    /// products' matrices), the integrals' N (nine numbers per pair of modes) and
     /// the texts held whole until they are written (outputs appear whole or not at all), each
     /// up to three times its length while it grows: the flex file (about
     /// [`FLEX_BYTES_PER_PAIR`] per pair of modes) and the state-space model's JSON
@@ -244,20 +252,7 @@ impl Scenario {
         let modes = self
             .export_modes()
             .map_or(elastic, |m| (m as u64).min(elastic));
-        // Points of the export's quadrature (export/mass.rs: terms + 4 per direction).
-        let points = 1
-            + st.masses.len() as u64
-            + st.beams
-                .iter()
-                .map(|b| {
-                    let t = b.terms;
-                    t.bending.max(t.torsion).max(t.axial) as u64 + 4
-                })
-                .sum::<u64>()
-            + st.plates
-                .iter()
-                .map(|p| (p.terms.length as u64 + 4) * (p.terms.width as u64 + 4))
-                .sum::<u64>();
+        let points = crate::export::element_count(st);
         let elements = points.saturating_mul(modes).saturating_mul(3 * 48 + 24);
         let pairs = modes.saturating_mul(modes);
         let integrals = pairs.saturating_mul(9 * 8);
@@ -297,6 +292,15 @@ impl Scenario {
             format_bytes(max_bytes)
         );
         let st = &self.structure;
+        if e.export_bytes >= e.peak_bytes() / 2 {
+            return Err(self.locate_key(
+                "export.modes",
+                format!(
+                    "the export of this many modes (42's N integrals and flex file grow with \
+                     their square): {why}"
+                ),
+            ));
+        }
         // Without time series (modes, export) only the terms can be blamed.
         let series = e.deployment_cells.max(e.response_cells) > 0;
         if e.modes_bytes >= e.peak_bytes() / 2 || !series {

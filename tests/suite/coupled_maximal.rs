@@ -126,8 +126,8 @@ fn clamped_family(n: usize, power: i32, xi: f64) -> Vec<[f64; 3]> {
 }
 
 /// [`clamped_family`] against closed forms: P*_0 … P*_3 are 1, 2ξ − 1, 6ξ² − 6ξ + 1,
-/// 20ξ³ − 30ξ² + 12ξ − 1 (Abramowitz & Stegun 22.2.11), times ξ² here, and their derivatives
-/// written out.
+/// 20ξ³ − 30ξ² + 12ξ − 1 (Abramowitz & Stegun 22.2.11), times ξ (the axial family) and ξ²
+/// (bending), and their derivatives written out.
 #[test]
 fn the_oracles_own_functions_are_the_shifted_legendre_polynomials_times_the_clamp() {
     // (P*, P*', P*'') of each degree.
@@ -146,18 +146,26 @@ fn the_oracles_own_functions_are_the_shifted_legendre_polynomials_times_the_clam
             |x| 120.0 * x - 60.0,
         ),
     ];
-    for xi in [0.0, 0.13, 0.5, 0.77, 1.0] {
-        let got = clamped_family(4, 2, xi);
+    for (power, xi) in [1, 2]
+        .into_iter()
+        .flat_map(|w| [0.0, 0.13, 0.5, 0.77, 1.0].map(|x| (w, x)))
+    {
+        let got = clamped_family(4, power, xi);
         for (k, (p, dp, ddp)) in polys.iter().enumerate() {
-            let want = [
-                xi * xi * p(xi),
-                2.0 * xi * p(xi) + xi * xi * dp(xi),
-                2.0 * p(xi) + 4.0 * xi * dp(xi) + xi * xi * ddp(xi),
-            ];
+            // (ξ^w P)′ = w ξ^(w−1) P + ξ^w P′, (ξ^w P)″ = w(w−1) ξ^(w−2) P + 2w ξ^(w−1) P′ + ξ^w P″.
+            let want = if power == 1 {
+                [xi * p(xi), p(xi) + xi * dp(xi), 2.0 * dp(xi) + xi * ddp(xi)]
+            } else {
+                [
+                    xi * xi * p(xi),
+                    2.0 * xi * p(xi) + xi * xi * dp(xi),
+                    2.0 * p(xi) + 4.0 * xi * dp(xi) + xi * xi * ddp(xi),
+                ]
+            };
             for d in 0..3 {
                 assert!(
                     (got[k][d] - want[d]).abs() <= 1e-13 * (1.0 + want[d].abs()),
-                    "k = {k}, ξ = {xi}, derivative {d}: {} vs {}",
+                    "power {power}, k = {k}, ξ = {xi}, derivative {d}: {} vs {}",
                     got[k][d],
                     want[d]
                 );

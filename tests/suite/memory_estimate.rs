@@ -1,14 +1,14 @@
 //! The memory estimate that refuses a run before it starts (`scenario/budget.rs`) against
 //! the memory the run really takes (issue 43): the peak resident set of the `flexcraft`
 //! process, read from the kernel when it ends (`ru_maxrss`), for every part the
-//! estimate models — a modal solve whose dense matrices dominate (a 30 × 30 plate: 924
+//! estimate models — a modal solve whose dense matrices dominate (a 30 × 30 plate: 932
 //! coordinates), the export's mass elements and 42 files, the deployment's time series and
 //! the response's.
 //!
 //! Each case must be bounded by its estimate (a run the budget lets through fits in it) and
 //! the estimate must stay within twice the measured peak (a budget that refuses runs that
 //! would fit, or that no longer models what dominates, fails). Measured 2026-11-28: estimates
-//! 1.15–1.6 times the peaks.
+//! 1.1–1.6 times the peaks.
 
 use super::common::{example, scratch};
 use flexcraft::scenario::RunParts;
@@ -81,7 +81,7 @@ fn plate_terms(n: usize) -> impl Fn(String) -> String {
     }
 }
 
-/// `modes` on the seed with a 30 × 30 plate (924 coordinates): the dense solve dominates.
+/// `modes` on the seed with a 30 × 30 plate (932 coordinates): the dense solve dominates.
 #[test]
 fn the_modal_solve_fits_its_estimate() {
     check("modes", plate_terms(30), "modes", RunParts::MODES);

@@ -273,7 +273,7 @@ fn lowest_eigenpairs_agree_with_the_dense_solver() {
 }
 
 /// Every hub-fixed mode of a large, ill-conditioned model is M-orthonormal: the seed with a
-/// 30 × 30 Legendre plate (924 coordinates, all 918 hub-fixed modes by the dense route),
+/// 30 × 30 Legendre plate (932 coordinates, all 926 hub-fixed modes by the dense route),
 /// max |ΦᵀMΦ − I| ≤ 1e-8 with the assembled mass matrix (measured 2.5e-9 on mode 786: the
 /// rounding of ΦᵀMΦ itself for the top modes of a mass matrix this ill-conditioned). NASA 42
 /// needs Mf = I of every exported mode (the export refuses above 1e-6); with one
