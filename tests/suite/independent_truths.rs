@@ -81,20 +81,33 @@ fn mass_property_examples() -> Vec<(String, Json, Scenario)> {
 fn structure_mass_properties_match_the_independent_integration() {
     for (name, truth, s) in mass_property_examples() {
         let body = s.structure.rigid_body();
-        let m = truth.get("mass").num();
-        let c = truth.get("center_of_mass").nums();
-        let j = truth.get("inertia_cm").matrix();
-        let trace = j[0][0] + j[1][1] + j[2][2];
-        let gyration = (trace / m).sqrt();
-        check(&format!("{name} mass"), body.mass, m, m, MASS_TOL);
-        let (gc, gj) = (body.center_of_mass(), body.inertia_at_cm());
-        for i in 0..3 {
-            let what = format!("{name} centre of mass [{i}]");
-            check(&what, gc.get(i), c[i], gyration, MASS_TOL);
-            for k in 0..3 {
-                let what = format!("{name} inertia about the centre of mass [{i}][{k}]");
-                check(&what, gj.get(i, k), j[i][k], trace, MASS_TOL);
-            }
+        let (c, j) = (body.center_of_mass(), body.inertia_at_cm());
+        check_rigid(&name, &truth, body.mass, c, j);
+    }
+}
+
+/// A mass, centre of mass and inertia about it against the fixture's entry `truth`: the mass
+/// to MASS_TOL of itself, the centre to MASS_TOL of the radius of gyration √(tr J_cm / M),
+/// the inertia to MASS_TOL of tr J_cm.
+fn check_rigid(
+    name: &str,
+    truth: &Json,
+    mass: f64,
+    centre: flexcraft::math::Vec3,
+    inertia: flexcraft::math::Mat3,
+) {
+    let m = truth.get("mass").num();
+    let c = truth.get("center_of_mass").nums();
+    let j = truth.get("inertia_cm").matrix();
+    let trace = j[0][0] + j[1][1] + j[2][2];
+    let gyration = (trace / m).sqrt();
+    check(&format!("{name} mass"), mass, m, m, MASS_TOL);
+    for i in 0..3 {
+        let what = format!("{name} centre of mass [{i}]");
+        check(&what, centre.get(i), c[i], gyration, MASS_TOL);
+        for k in 0..3 {
+            let what = format!("{name} inertia about the centre of mass [{i}][{k}]");
+            check(&what, inertia.get(i, k), j[i][k], trace, MASS_TOL);
         }
     }
 }
@@ -139,7 +152,8 @@ fn ritz_hub_mass_block_matches_the_independent_integration() {
 /// NASA 42's mass elements (`export::mass_elements`: quadrature points of every beam and plate,
 /// the hub and the lumped bodies, each with its mass and own inertia) summed into the whole
 /// spacecraft's mass, centre of mass and inertia about it, against the Python integration:
-/// the same tolerances as [`structure_mass_properties_match_the_independent_integration`].
+/// the same tolerances as [`structure_mass_properties_match_the_independent_integration`]
+/// ([`check_rigid`]).
 /// The examples hold every kind of element: beams on the hub and on a beam (full), plates on
 /// a beam, lumped masses with products of inertia. A plate or a beam left out, a quadrature
 /// weight off, a line inertia about the wrong axis is caught.
@@ -160,20 +174,7 @@ fn export_mass_elements_match_the_independent_integration() {
         });
         let c = first * (1.0 / mass);
         let j_cm = j_o - steiner(c, mass);
-        let m = truth.get("mass").num();
-        let tc = truth.get("center_of_mass").nums();
-        let j = truth.get("inertia_cm").matrix();
-        let trace = j[0][0] + j[1][1] + j[2][2];
-        let gyration = (trace / m).sqrt();
-        check(&format!("{name} elements' mass"), mass, m, m, MASS_TOL);
-        for i in 0..3 {
-            let what = format!("{name} elements' centre of mass [{i}]");
-            check(&what, c.get(i), tc[i], gyration, MASS_TOL);
-            for k in 0..3 {
-                let what = format!("{name} elements' inertia about the centre of mass [{i}][{k}]");
-                check(&what, j_cm.get(i, k), j[i][k], trace, MASS_TOL);
-            }
-        }
+        check_rigid(&format!("{name} elements'"), &truth, mass, c, j_cm);
     }
 }
 
