@@ -130,6 +130,9 @@ impl Simulation {
                         });
                     }
                 }
+                if let Some(w) = costly_peaks(&modal, settings) {
+                    warnings.push(w);
+                }
                 if let Some(highest) = aliased(&modal, settings) {
                     warnings.push(Warning::Aliasing {
                         output_rate: settings.output_rate,
@@ -215,6 +218,35 @@ fn large_deflections(
     }
     out
 }
+
+/// [`Warning::CostlyPeaks`] when the response keeps every elastic mode (no `[response]
+/// modes`) and the peaks' grid has more than [`COSTLY_KNOTS`] points (about a second per
+/// pass on the 2-core benchmark machine): generated spacecraft with explicit terms keep modes
+/// up to 11 kHz, 5.3 million points over 60 s.
+pub fn costly_peaks(
+    modal: &ModalResponse,
+    settings: &crate::response::ResponseSettings,
+) -> Option<Warning> {
+    if settings.modes.is_some() {
+        return None;
+    }
+    let elastic: Vec<f64> = modal
+        .modes
+        .iter()
+        .filter(|m| !m.rigid)
+        .map(|m| m.omega_rad_s)
+        .collect();
+    let fastest = elastic.iter().copied().fold(0.0, f64::max);
+    let knots = crate::response::extrema::grid(fastest, settings.duration).len();
+    (knots > COSTLY_KNOTS).then_some(Warning::CostlyPeaks {
+        kept: elastic.len(),
+        highest_hz: fastest / (2.0 * std::f64::consts::PI),
+        knots,
+    })
+}
+
+/// The peak search's grid points per pass above which [`costly_peaks`] warns.
+pub const COSTLY_KNOTS: usize = 1_000_000;
 
 /// The highest kept elastic frequency (Hz) when the response's output rate is below 2.5
 /// times it (the samples then alias the ringing), None otherwise.

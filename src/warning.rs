@@ -48,6 +48,17 @@ pub enum Warning {
         /// The highest kept elastic frequency, Hz.
         highest_hz: f64,
     },
+    /// The response keeps every elastic mode (no `[response] modes`) up to a frequency whose
+    /// exact peaks need a long closed-form search: its grid resolves the highest kept mode
+    /// over the whole duration.
+    CostlyPeaks {
+        /// Elastic modes kept.
+        kept: usize,
+        /// The highest kept elastic frequency, Hz.
+        highest_hz: f64,
+        /// The search's grid points per pass.
+        knots: usize,
+    },
     /// More elastic modes requested than the model has: all are kept.
     ModesClamped {
         /// `response.modes`.
@@ -162,14 +173,15 @@ impl fmt::Display for Warning {
                 output_rate,
                 highest_hz,
             } => aliasing(f, *output_rate, *highest_hz),
+            Self::CostlyPeaks {
+                kept,
+                highest_hz,
+                knots,
+            } => costly_peaks(f, *kept, *highest_hz, *knots),
             Self::ModesClamped {
                 requested,
                 available,
-            } => write!(
-                f,
-                "response.modes = {requested} but the model has {available} elastic modes: all \
-                 of them are kept"
-            ),
+            } => modes_clamped(f, *requested, *available),
             Self::NotSettled {
                 t,
                 ratio,
@@ -244,6 +256,32 @@ impl fmt::Display for Warning {
 
 /// [`Warning::NoResponse`]'s text.
 const NO_RESPONSE: &str = "the array did not latch completely: no hand-over, no response";
+
+/// [`Warning::ModesClamped`]'s text.
+fn modes_clamped(f: &mut fmt::Formatter<'_>, requested: usize, available: usize) -> fmt::Result {
+    write!(
+        f,
+        "response.modes = {requested} but the model has {available} elastic modes: all of them \
+         are kept"
+    )
+}
+
+/// [`Warning::CostlyPeaks`]'s text.
+fn costly_peaks(
+    f: &mut fmt::Formatter<'_>,
+    kept: usize,
+    highest_hz: f64,
+    knots: usize,
+) -> fmt::Result {
+    write!(
+        f,
+        "the response keeps all {kept} elastic modes, the highest at {highest_hz:.1} Hz: its \
+         exact peaks and stresses resolve them over the whole response ({:.1} million grid \
+         points per pass, most of this run's time); `[response] modes` keeps only the lowest \
+         ones where the others do not matter",
+        knots as f64 / 1e6
+    )
+}
 
 /// [`Warning::Aliasing`]'s text.
 fn aliasing(f: &mut fmt::Formatter<'_>, output_rate: f64, highest_hz: f64) -> fmt::Result {

@@ -408,3 +408,44 @@ fn hand_over_residual_shrinks_as_plate_terms_are_added() {
     assert!(residuals[0].1 > 1e-6 * residuals[0].2, "{residuals:?}");
     assert!(residuals[0].2 > 1e-3, "energy handed over: {residuals:?}");
 }
+
+/// `Warning::CostlyPeaks`: with every elastic mode kept (no `[response] modes`) the exact
+/// peaks' grid is ⌈T ω_max / (π/4)⌉ + 1 points (T the duration, ω_max the highest kept
+/// mode, computed here from the modes), and above a million the run says so and names
+/// `[response] modes`; with `modes` given, or a short response, it says nothing.
+#[test]
+fn a_costly_peak_search_says_so_and_names_the_lever() {
+    use flexcraft::simulation::{costly_peaks, COSTLY_KNOTS};
+    let s = scenario(include_str!("../../examples/seed.toml"));
+    let model = RitzModel::assemble(&s.structure);
+    let modes = ModalAnalysis::compute(&model).expect("modes");
+    let zeros = vec![0.0; modes.modes.len()];
+    let omega_max = modes
+        .modes
+        .iter()
+        .filter(|m| !m.rigid)
+        .map(|m| m.omega_rad_s)
+        .fold(0.0, f64::max);
+    let knots = |t: f64| (t * omega_max / (0.25 * std::f64::consts::PI)).ceil() as usize + 1;
+    // Just above and just below the threshold.
+    let long = 1.01 * COSTLY_KNOTS as f64 * 0.25 * std::f64::consts::PI / omega_max;
+    let short = 0.99 * COSTLY_KNOTS as f64 * 0.25 * std::f64::consts::PI / omega_max;
+    let settings = |duration: f64, modes: Option<usize>| ResponseSettings {
+        duration,
+        modes,
+        ..s.response
+    };
+    let warn = |st: &ResponseSettings| {
+        let modal = ModalResponse::with_initial(&modes, &zeros, &zeros, st);
+        costly_peaks(&modal, st)
+    };
+    let w = warn(&settings(long, None)).expect("a long response with every mode warns");
+    let text = w.to_string();
+    assert!(
+        text.contains(&format!("{:.1} million", knots(long) as f64 / 1e6))
+            && text.contains("[response] modes"),
+        "{text}"
+    );
+    assert!(warn(&settings(short, None)).is_none());
+    assert!(warn(&settings(long, Some(20))).is_none());
+}
