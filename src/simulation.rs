@@ -230,19 +230,22 @@ pub fn costly_peaks(
     if settings.modes.is_some() {
         return None;
     }
-    let elastic: Vec<f64> = modal
-        .modes
-        .iter()
-        .filter(|m| !m.rigid)
-        .map(|m| m.omega_rad_s)
-        .collect();
-    let fastest = elastic.iter().copied().fold(0.0, f64::max);
+    let (kept, fastest) = elastic_modes(modal);
     let knots = crate::response::extrema::grid(fastest, settings.duration).len();
     (knots > COSTLY_KNOTS).then_some(Warning::CostlyPeaks {
-        kept: elastic.len(),
+        kept,
         highest_hz: fastest / (2.0 * std::f64::consts::PI),
         knots,
     })
+}
+
+/// The response's kept elastic modes: their count and the highest ω (rad/s, 0 for none).
+fn elastic_modes(modal: &ModalResponse) -> (usize, f64) {
+    modal
+        .modes
+        .iter()
+        .filter(|m| !m.rigid)
+        .fold((0, 0.0), |(n, w), m| (n + 1, f64::max(w, m.omega_rad_s)))
 }
 
 /// The peak search's grid points per pass above which [`costly_peaks`] warns.
@@ -251,11 +254,6 @@ pub const COSTLY_KNOTS: usize = 1_000_000;
 /// The highest kept elastic frequency (Hz) when the response's output rate is below 2.5
 /// times it (the samples then alias the ringing), None otherwise.
 pub fn aliased(modal: &ModalResponse, settings: &crate::response::ResponseSettings) -> Option<f64> {
-    let highest = modal
-        .modes
-        .iter()
-        .filter(|m| !m.rigid)
-        .map(|m| m.omega_rad_s / (2.0 * std::f64::consts::PI))
-        .fold(0.0, f64::max);
+    let highest = elastic_modes(modal).1 / (2.0 * std::f64::consts::PI);
     (highest > 0.0 && settings.output_rate < 2.5 * highest).then_some(highest)
 }
