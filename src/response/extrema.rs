@@ -111,6 +111,53 @@ impl WaveSum {
     }
 }
 
+/// Several signals whose waves share their (σ, ω), wave by wave (the channels of one modal
+/// superposition: wave k is mode k's in each), evaluated together: the modes' e^{−σt}cos ωt
+/// and e^{−σt}sin ωt once per time, then each signal as a dot product — one `sin_cos` per
+/// mode instead of one per mode and signal.
+#[derive(Debug, Clone)]
+pub struct Bank<'a> {
+    signals: Vec<&'a WaveSum>,
+    /// (σ, ω) of wave k, shared by every signal.
+    modes: Vec<(f64, f64)>,
+}
+
+impl<'a> Bank<'a> {
+    /// The bank of `signals`, or None if their waves do not share (σ, ω) wave by wave.
+    pub fn new(signals: Vec<&'a WaveSum>) -> Option<Self> {
+        let modes: Vec<(f64, f64)> = signals
+            .first()
+            .map(|s| s.waves.iter().map(|w| (w.sigma, w.omega)).collect())
+            .unwrap_or_default();
+        let shared = signals.iter().all(|s| {
+            s.waves.len() == modes.len()
+                && s.waves
+                    .iter()
+                    .zip(&modes)
+                    .all(|(w, m)| w.sigma == m.0 && w.omega == m.1)
+        });
+        shared.then_some(Self { signals, modes })
+    }
+
+    /// Every signal's (v(t), v′(t)) into `out` (one entry per signal).
+    pub fn at(&self, t: f64, out: &mut [(f64, f64)]) {
+        for (o, s) in out.iter_mut().zip(&self.signals) {
+            *o = (s.constant + s.slope * t, s.slope);
+        }
+        for (k, &(sigma, omega)) in self.modes.iter().enumerate() {
+            let (sn, cs) = (omega * t).sin_cos();
+            let d = (-sigma * t).exp();
+            let (c, s_) = (d * cs, d * sn);
+            for (o, sig) in out.iter_mut().zip(&self.signals) {
+                let w = &sig.waves[k];
+                // v = p c + q s; v′ = (ωq − σp) c − (σq + ωp) s.
+                o.0 += w.p * c + w.q * s_;
+                o.1 += (omega * w.q - sigma * w.p) * c - (sigma * w.q + omega * w.p) * s_;
+            }
+        }
+    }
+}
+
 /// The kept intervals' count at which a search first drops those the best has overtaken.
 const PRUNE_AT: usize = 4096;
 
@@ -275,6 +322,8 @@ impl Objective for Scalar<'_> {
 #[derive(Debug, Clone)]
 pub struct SquaredNorm<'a> {
     parts: Vec<Scalar<'a>>,
+    /// The components evaluated together when their waves share (σ, ω).
+    bank: Option<Bank<'a>>,
 }
 
 impl<'a> SquaredNorm<'a> {
@@ -282,12 +331,20 @@ impl<'a> SquaredNorm<'a> {
     pub fn new(vs: &[&'a WaveSum], t_end: f64) -> Self {
         Self {
             parts: vs.iter().map(|v| Scalar::new(v, t_end)).collect(),
+            bank: Bank::new(vs.to_vec()),
         }
     }
 }
 
 impl Objective for SquaredNorm<'_> {
     fn at(&self, t: f64) -> (f64, f64) {
+        if let Some(bank) = &self.bank {
+            let mut out = vec![(0.0, 0.0); self.parts.len()];
+            bank.at(t, &mut out);
+            return out.iter().fold((0.0, 0.0), |(g, dg), (v, dv)| {
+                (g + v * v, dg + 2.0 * v * dv)
+            });
+        }
         self.parts.iter().fold((0.0, 0.0), |(g, dg), p| {
             let (v, dv) = p.at(t);
             (g + v * v, dg + 2.0 * v * dv)
@@ -550,6 +607,43 @@ mod tests {
             (v - 2.0).abs() < 1e-14 && (t - 0.5).abs() < 1e-14,
             "{v} {t}"
         );
+    }
+
+    #[test]
+    fn a_bank_evaluates_each_signal_and_its_slope_as_alone() {
+        // Three channels of four shared modes: the bank's (v, v′) against each signal's own
+        // closed form and a central difference of it; a signal whose waves differ is refused.
+        let modes = [(0.0, 3.0), (0.2, 17.0), (0.01, 40.0), (1.5, 91.0)];
+        let signal = |k: f64| WaveSum {
+            constant: 0.3 * k,
+            slope: -0.1 * k,
+            waves: modes
+                .iter()
+                .enumerate()
+                .map(|(j, &(sigma, omega))| Wave {
+                    sigma,
+                    omega,
+                    p: (k + j as f64).sin(),
+                    q: (2.0 * k - j as f64).cos(),
+                })
+                .collect(),
+        };
+        let sigs = [signal(1.0), signal(2.0), signal(3.0)];
+        let bank = Bank::new(sigs.iter().collect()).expect("shared modes");
+        let mut out = [(0.0, 0.0); 3];
+        for t in [0.0, 0.013, 0.7, 2.5] {
+            bank.at(t, &mut out);
+            for (s, (v, dv)) in sigs.iter().zip(out) {
+                let h = 1e-6;
+                let fd = (s.at(t + h) - s.at(t - h)) / (2.0 * h);
+                assert!((v - s.at(t)).abs() < 1e-13, "{v} {}", s.at(t));
+                assert!((dv - s.derivative().at(t)).abs() < 1e-11);
+                assert!((dv - fd).abs() < 1e-6 * s.scale(3.0) * 91.0, "{dv} {fd}");
+            }
+        }
+        let mut other = signal(4.0);
+        other.waves[2].omega = 41.0;
+        assert!(Bank::new(vec![&sigs[0], &other]).is_none());
     }
 
     #[test]

@@ -139,11 +139,17 @@ pub fn stresses(r: [f64; 6], section: &BeamSection, fibres: &SectionFibres) -> S
     }
 }
 
-/// The stresses' slope dσ_vm/dt from the resultants and their rates (where σ_vm is smooth:
+/// The stresses' slope dσ_vm/dt from the resultants `r`, their stresses `s` and their rates
+/// (where σ_vm is smooth:
 /// away from a resultant's zero, which is a minimum of its magnitude, never a maximum of
 /// σ_vm's).
-fn von_mises_rate(r: [f64; 6], dr: [f64; 6], section: &BeamSection, f: &SectionFibres) -> f64 {
-    let s = stresses(r, section, f);
+fn von_mises_rate(
+    s: &Stresses,
+    r: [f64; 6],
+    dr: [f64; 6],
+    section: &BeamSection,
+    f: &SectionFibres,
+) -> f64 {
     if s.von_mises == 0.0 {
         return 0.0;
     }
@@ -181,6 +187,10 @@ fn von_mises_rate(r: [f64; 6], dr: [f64; 6], section: &BeamSection, f: &SectionF
 /// 1e-3 of a mode's amplitude).
 pub const REFINE_WINDOW: f64 = 5e-3;
 
+/// A section's peak stress at or below this fraction of the largest section's is rounding
+/// noise, reported as zero (the project's rule for every displayed quantity).
+pub const NOISE: f64 = 1e-9;
+
 /// The peak of σ_vm at one section over the response.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StressPeak {
@@ -192,19 +202,34 @@ pub struct StressPeak {
     pub resultants: [f64; 6],
 }
 
-/// The largest σ_vm over [0, duration] of each section whose six resultant channels are
-/// `channels[6k..6k + 6]` (module doc): one pass over the grid for all of them.
+/// The largest σ_vm over [0, duration] of each section k whose six resultant channels are
+/// `channels[6k..6k + 6]` and whose section and fibres are `sections[k]` (module doc): one
+/// pass over the grid for all of them (every beam's stations together: the modes are
+/// evaluated on the grid once).
 pub fn peak_von_mises(
     response: &ModalResponse,
     modal: &ModalAnalysis,
     channels: &[Channel],
-    section: &BeamSection,
-    fibres: &SectionFibres,
+    sections: &[(&BeamSection, &SectionFibres)],
     duration: f64,
 ) -> Vec<StressPeak> {
     let signals = response.signals(modal, channels);
     let count = channels.len() / 6;
-    let at = |k: usize, t: f64| -> [f64; 6] { std::array::from_fn(|j| signals[6 * k + j].at(t)) };
+    debug_assert_eq!(count, sections.len());
+    // Each section's six resultants evaluated together: one sin_cos per mode, not six.
+    let banks: Vec<Option<extrema::Bank>> = (0..count)
+        .map(|k| extrema::Bank::new(signals[6 * k..6 * k + 6].iter().collect()))
+        .collect();
+    let at = |k: usize, t: f64| -> [f64; 6] {
+        match &banks[k] {
+            Some(bank) => {
+                let mut out = [(0.0, 0.0); 6];
+                bank.at(t, &mut out);
+                out.map(|o| o.0)
+            }
+            None => std::array::from_fn(|j| signals[6 * k + j].at(t)),
+        }
+    };
     let fastest = signals.iter().map(WaveSum::fastest).fold(0.0, f64::max);
     let grid = extrema::grid(fastest, duration.max(0.0));
     // First pass: every interval's interpolated largest value, per section.
@@ -220,13 +245,13 @@ pub fn peak_von_mises(
             for (i, &t) in times.iter().enumerate() {
                 let r: [f64; 6] = std::array::from_fn(|j| values[(i, 6 * k + j)]);
                 let dr: [f64; 6] = std::array::from_fn(|j| slopes[(i, 6 * k + j)]);
-                let knot = (
-                    t,
-                    stresses(r, section, fibres).von_mises,
-                    von_mises_rate(r, dr, section, fibres),
-                );
+                let (section, fibres) = sections[k];
+                let s = stresses(r, section, fibres);
+                let knot = (t, s.von_mises, von_mises_rate(&s, r, dr, section, fibres));
                 if let Some(a) = *prev {
-                    if t > a.0 && hermite_bound(a, knot) >= (1.0 - REFINE_WINDOW) * *best {
+                    // A section with no stress at all (a beam's free tip) keeps no interval.
+                    let bound = hermite_bound(a, knot);
+                    if t > a.0 && bound > 0.0 && bound >= (1.0 - REFINE_WINDOW) * *best {
                         let (est, where_) = hermite_max(a, knot);
                         if est >= (1.0 - REFINE_WINDOW) * *best {
                             *best = best.max(est);
@@ -243,8 +268,19 @@ pub fn peak_von_mises(
             }
         }
     });
+    // A section whose stress is rounding noise against the largest of all of them (within
+    // NOISE of it: a free tip's resultants) has none: its every grid interval would qualify.
+    let largest = best_estimate.iter().fold(0.0_f64, |m, &b| m.max(b));
     (0..count)
         .map(|k| {
+            let (section, fibres) = sections[k];
+            if best_estimate[k] <= NOISE * largest {
+                return StressPeak {
+                    time: 0.0,
+                    stresses: stresses([0.0; 6], section, fibres),
+                    resultants: [0.0; 6],
+                };
+            }
             let vm = |t: f64| stresses(at(k, t), section, fibres).von_mises;
             let floor = (1.0 - REFINE_WINDOW) * best_estimate[k];
             let mut list = std::mem::take(&mut intervals[k]);
@@ -314,26 +350,34 @@ pub fn beam_stresses(
     duration: f64,
 ) -> Vec<BeamStresses> {
     let st = &model.structure;
-    let mut out = Vec::new();
+    // Every beam with known fibres: its stations, and their channels and sections in one list.
+    let mut beams = Vec::new();
+    let mut channels = Vec::new();
     for (i, b) in st.beams.iter().enumerate() {
         let Some(bs) = spec.beams.get(i) else {
             continue;
         };
-        let Some(fibres) = bs.fibres else {
+        let Some(fibres) = &bs.fibres else {
             continue;
         };
         let xs = super::sections::stations(st, i);
-        let channels = super::sections::beam_section_channels(model, i, &xs);
-        let peaks = peak_von_mises(response, modes, &channels, &b.section, &fibres, duration);
-        let stations = xs.into_iter().zip(peaks).collect();
-        out.push(BeamStresses {
+        channels.extend(super::sections::beam_section_channels(model, i, &xs));
+        beams.push((i, b, bs, fibres, xs));
+    }
+    let sections: Vec<(&BeamSection, &SectionFibres)> = beams
+        .iter()
+        .flat_map(|(_, b, _, fibres, xs)| xs.iter().map(move |_| (&b.section, *fibres)))
+        .collect();
+    let mut peaks = peak_von_mises(response, modes, &channels, &sections, duration).into_iter();
+    beams
+        .into_iter()
+        .map(|(i, b, bs, _, xs)| BeamStresses {
             beam: i,
             name: b.name.clone(),
-            stations,
+            stations: xs.into_iter().zip(peaks.by_ref()).collect(),
             allowable: bs.allowable,
-        });
-    }
-    out
+        })
+        .collect()
 }
 
 /// The largest value of f near the middle point of a bracket (a, m, b), a < m < b, by

@@ -264,10 +264,18 @@ impl ModalResponse {
         grid: &extrema::Grid,
         f: &mut GridPiece<'_>,
     ) {
-        let (gd, ga) = (
-            self.gains(modal, channels, Order::Displacement),
-            self.gains(modal, channels, Order::Acceleration),
-        );
+        // The channels reading η and those reading η̈, each with its own gains (the other
+        // order's would be zeros: a product with them is wasted work).
+        let order_of = |order: Order| -> (Vec<usize>, Mat<f64>) {
+            let idx: Vec<usize> = (0..channels.len())
+                .filter(|&c| channels[c].order == order)
+                .collect();
+            let g = self.gains(modal, channels, order);
+            let compact = Mat::from_fn(g.nrows(), idx.len(), |j, k| g[(j, idx[k])]);
+            (idx, compact)
+        };
+        let (id, gd) = order_of(Order::Displacement);
+        let (ia, ga) = order_of(Order::Acceleration);
         let nm = self.modes.len();
         let zeta = self.damping_ratio;
         let h = grid.spacing();
@@ -306,12 +314,16 @@ impl ModalResponse {
                     eddd[(i, j)] = -2.0 * zeta * w * xdd - w * w * xd;
                 }
             }
-            values
-                .subrows_mut(0, rows)
-                .copy_from(e.subrows(0, rows) * &gd + edd.subrows(0, rows) * &ga);
-            slopes
-                .subrows_mut(0, rows)
-                .copy_from(ed.subrows(0, rows) * &gd + eddd.subrows(0, rows) * &ga);
+            for (idx, g, x, dx) in [(&id, &gd, &e, &ed), (&ia, &ga, &edd, &eddd)] {
+                if idx.is_empty() {
+                    continue;
+                }
+                let (v, dv) = (x.subrows(0, rows) * g, dx.subrows(0, rows) * g);
+                for (k, &c) in idx.iter().enumerate() {
+                    values.col_mut(c).subrows_mut(0, rows).copy_from(v.col(k));
+                    slopes.col_mut(c).subrows_mut(0, rows).copy_from(dv.col(k));
+                }
+            }
             for (c, ch) in channels.iter().enumerate() {
                 if ch.offset != 0.0 {
                     for i in 0..rows {
