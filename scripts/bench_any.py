@@ -7,7 +7,8 @@ best of ROUNDS; the evaluation count, the base model and the accuracy estimate f
 `deploy --json`.
 
 Usage: scripts/bench_any.sh (builds the release binary first), or
-    python3 scripts/bench_any.py [ROUNDS]
+    python3 scripts/bench_any.py [ROUNDS] [--simulate]
+(--simulate adds one `simulate` of every benchmark spacecraft: minutes).
 """
 
 import json
@@ -63,7 +64,8 @@ def deploy_row(path, rounds):
 
 
 def main():
-    rounds = int(sys.argv[1]) if len(sys.argv) > 1 else 3
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    rounds = int(args[0]) if args else 3
     files = [
         os.path.join(ROOT, "examples", f)
         for f in ["seed.toml", "seed_compliant.toml", "seed_staged.toml", "free_hub.toml", "montecarlo.toml"]
@@ -85,6 +87,15 @@ def main():
         cpu, _, _ = cpu_of([BIN, "simulate", os.path.join(ROOT, "examples", "seed.toml")])
         best = cpu if best is None else min(best, cpu)
     print(f"\n`flexcraft simulate examples/seed.toml` (the README's main command): {best:.3f} s CPU")
+    if "--simulate" in sys.argv:
+        # The whole story on the benchmark set: the deployment above plus the modes and the
+        # response's exact peaks and stresses, whose grid resolves the highest kept mode over
+        # the whole duration (docs/theory.md §3.2; issue 38's cost of the exact peaks).
+        print("\n| case | `simulate` wall [s] | CPU [s] |")
+        print("|---|---|---|")
+        for f in files[5:]:
+            cpu, wall, _ = cpu_of([BIN, "simulate", f])
+            print(f"| {os.path.relpath(f, ROOT)} | {wall:.2f} | {cpu:.2f} |")
 
 
 if __name__ == "__main__":

@@ -454,6 +454,18 @@ impl<O: Objective> PeakSearch<O> {
         });
     }
 
+    /// The search over the knots fed to `self` and then those fed to `later` (a search of
+    /// the same objective over the next segment of the grid, sharing its first knot with
+    /// this one's last): the best of both (this one's on a tie) and both lists of intervals.
+    pub fn merge(mut self, later: Self) -> Self {
+        if later.best.value > self.best.value {
+            self.best = later.best;
+        }
+        self.open.extend(later.open);
+        self.last = later.last.or(self.last);
+        self
+    }
+
     /// The peak |g| and its time.
     pub fn finish(mut self) -> (f64, f64) {
         let mut open = std::mem::take(&mut self.open);
@@ -536,11 +548,30 @@ impl Grid {
     /// The knot ranges [start, end] of consecutive pieces of at most `size` knots (≥ 2) that
     /// share their end knots.
     pub fn pieces(&self, size: usize) -> impl Iterator<Item = (usize, usize)> {
-        let (last, step) = (self.intervals, size.max(2) - 1);
+        self.pieces_within((0, self.intervals), size)
+    }
+
+    /// [`Grid::pieces`] of the knots `first..=last` only.
+    pub fn pieces_within(
+        &self,
+        (first, last): (usize, usize),
+        size: usize,
+    ) -> impl Iterator<Item = (usize, usize)> {
+        let step = size.max(2) - 1;
         (0..)
-            .map(move |i| i * step)
+            .map(move |i| first + i * step)
             .take_while(move |&start| start < last)
             .map(move |start| (start, (start + step).min(last)))
+    }
+
+    /// The knot ranges [start, end] of the grid cut into `count` (at least one) nearly equal
+    /// segments that share their end knots: parts a search may walk side by side, fixed by
+    /// the grid alone so that results do not depend on the number of threads.
+    pub fn segments(&self, count: usize) -> Vec<(usize, usize)> {
+        let count = count.clamp(1, self.intervals);
+        (0..count)
+            .map(|i| (self.intervals * i / count, self.intervals * (i + 1) / count))
+            .collect()
     }
 }
 

@@ -234,40 +234,53 @@ pub fn peak_von_mises(
     let grid = extrema::grid(fastest, duration.max(0.0));
     // First pass: every interval's interpolated largest value, per section.
     type Knot = (f64, f64, f64);
-    let mut intervals: Vec<Vec<(f64, f64, Knot, Knot)>> = vec![Vec::new(); count];
-    let mut best_estimate = vec![0.0_f64; count];
-    let mut last: Vec<Option<Knot>> = vec![None; count];
-    // Each list is pruned when it doubles what the last pruning left (O(1) per interval).
-    let mut prune_at = vec![4096_usize; count];
-    response.on_grid(modal, channels, &grid, &mut |times, values, slopes| {
-        for k in 0..count {
-            let (list, best, prev) = (&mut intervals[k], &mut best_estimate[k], &mut last[k]);
-            for (i, &t) in times.iter().enumerate() {
-                let r: [f64; 6] = std::array::from_fn(|j| values[(i, 6 * k + j)]);
-                let dr: [f64; 6] = std::array::from_fn(|j| slopes[(i, 6 * k + j)]);
+    // Per section: the kept intervals, the best estimate, the last knot and the length at
+    // which the list is pruned next (when it doubles what the last pruning left: O(1) per
+    // interval). Each segment of the grid is walked on its own, the lists then joined.
+    type State = (Vec<(f64, f64, Knot, Knot)>, f64, Option<Knot>, usize);
+    let init = || -> Vec<State> { vec![(Vec::new(), 0.0, None, 4096); count] };
+    let segments = response.on_grid_segments(
+        modal,
+        channels,
+        &grid,
+        init,
+        |state, times, values, slopes| {
+            for (k, (list, best, prev, prune_at)) in state.iter_mut().enumerate() {
                 let (section, fibres) = sections[k];
-                let s = stresses(r, section, fibres);
-                let knot = (t, s.von_mises, von_mises_rate(&s, r, dr, section, fibres));
-                if let Some(a) = *prev {
-                    // A section with no stress at all (a beam's free tip) keeps no interval.
-                    let bound = hermite_bound(a, knot);
-                    if t > a.0 && bound > 0.0 && bound >= (1.0 - REFINE_WINDOW) * *best {
-                        let (est, where_) = hermite_max(a, knot);
-                        if est >= (1.0 - REFINE_WINDOW) * *best {
-                            *best = best.max(est);
-                            list.push((est, where_, a, knot));
-                            if list.len() > prune_at[k] {
-                                let floor = (1.0 - REFINE_WINDOW) * *best;
-                                list.retain(|x| x.0 >= floor);
-                                prune_at[k] = 4096.max(2 * list.len());
+                for (i, &t) in times.iter().enumerate() {
+                    let r: [f64; 6] = std::array::from_fn(|j| values[(i, 6 * k + j)]);
+                    let dr: [f64; 6] = std::array::from_fn(|j| slopes[(i, 6 * k + j)]);
+                    let s = stresses(r, section, fibres);
+                    let knot = (t, s.von_mises, von_mises_rate(&s, r, dr, section, fibres));
+                    if let Some(a) = *prev {
+                        // A section with no stress at all (a beam's free tip) keeps no interval.
+                        let bound = hermite_bound(a, knot);
+                        if t > a.0 && bound > 0.0 && bound >= (1.0 - REFINE_WINDOW) * *best {
+                            let (est, where_) = hermite_max(a, knot);
+                            if est >= (1.0 - REFINE_WINDOW) * *best {
+                                *best = best.max(est);
+                                list.push((est, where_, a, knot));
+                                if list.len() > *prune_at {
+                                    let floor = (1.0 - REFINE_WINDOW) * *best;
+                                    list.retain(|x| x.0 >= floor);
+                                    *prune_at = 4096.max(2 * list.len());
+                                }
                             }
                         }
                     }
+                    *prev = Some(knot);
                 }
-                *prev = Some(knot);
             }
+        },
+    );
+    let mut intervals: Vec<Vec<(f64, f64, Knot, Knot)>> = vec![Vec::new(); count];
+    let mut best_estimate = vec![0.0_f64; count];
+    for state in segments {
+        for (k, (list, best, _, _)) in state.into_iter().enumerate() {
+            intervals[k].extend(list);
+            best_estimate[k] = best_estimate[k].max(best);
         }
-    });
+    }
     // A section whose stress is rounding noise against the largest of all of them (within
     // NOISE of it: a free tip's resultants) has none: its every grid interval would qualify.
     let largest = best_estimate.iter().fold(0.0_f64, |m, &b| m.max(b));

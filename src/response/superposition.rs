@@ -264,6 +264,44 @@ impl ModalResponse {
         grid: &extrema::Grid,
         f: &mut GridPiece<'_>,
     ) {
+        self.on_grid_within(modal, channels, grid, (0, grid.intervals), f);
+    }
+
+    /// [`Self::on_grid`] in [`extrema::Grid::segments`] walked side by side: `init()` makes
+    /// each segment's state, `f` is handed it with every piece of its segment, and the states
+    /// come back in time order (the segments depend on the grid only, so the results do not
+    /// depend on the number of threads). Long grids only: a short one is one segment.
+    pub fn on_grid_segments<S: Send>(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+        grid: &extrema::Grid,
+        init: impl Fn() -> S + Sync + Send,
+        f: impl Fn(&mut S, &[f64], MatRef<'_, f64>, MatRef<'_, f64>) + Sync + Send,
+    ) -> Vec<S> {
+        let count = if grid.len() > SEGMENT_KNOTS {
+            SEGMENTS
+        } else {
+            1
+        };
+        crate::ritz::parallel::map(&grid.segments(count), |&range| {
+            let mut state = init();
+            self.on_grid_within(modal, channels, grid, range, &mut |t, v, dv| {
+                f(&mut state, t, v, dv)
+            });
+            state
+        })
+    }
+
+    /// [`Self::on_grid`] over the knots `first..=last` only.
+    fn on_grid_within(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+        grid: &extrema::Grid,
+        range: (usize, usize),
+        f: &mut GridPiece<'_>,
+    ) {
         // The channels reading η and those reading η̈, each with its own gains (the other
         // order's would be zeros: a product with them is wasted work).
         let order_of = |order: Order| -> (Vec<usize>, Mat<f64>) {
@@ -279,7 +317,7 @@ impl ModalResponse {
         let nm = self.modes.len();
         let zeta = self.damping_ratio;
         let h = grid.spacing();
-        let chunk = PEAK_CHUNK.min(grid.len());
+        let chunk = PEAK_CHUNK.min(range.1 - range.0 + 1);
         let (mut e, mut ed, mut edd, mut eddd) = (
             Mat::<f64>::zeros(chunk, nm),
             Mat::<f64>::zeros(chunk, nm),
@@ -289,7 +327,7 @@ impl ModalResponse {
         let mut values = Mat::<f64>::zeros(chunk, channels.len());
         let mut slopes = Mat::<f64>::zeros(chunk, channels.len());
         let mut times = Vec::with_capacity(chunk);
-        for (start, end) in grid.pieces(chunk) {
+        for (start, end) in grid.pieces_within(range, chunk) {
             let rows = end - start + 1;
             times.clear();
             times.extend((start..=end).map(|k| grid.at(k)));
@@ -416,38 +454,57 @@ impl ModalResponse {
         duration: f64,
     ) -> (Vec<Peak>, Vec<Peak>) {
         let signals = self.signals(modal, channels);
-        let mut norms: Vec<PeakSearch<SquaredNorm>> = groups
-            .iter()
-            .map(|g| {
-                let parts: Vec<&WaveSum> = g.iter().map(|&c| &signals[c]).collect();
-                PeakSearch::new(SquaredNorm::new(&parts, duration.max(0.0)))
-            })
-            .collect();
         let fastest = signals.iter().map(WaveSum::fastest).fold(0.0, f64::max);
         let grid = extrema::grid(fastest, duration.max(0.0));
-        let mut searches: Vec<PeakSearch<Scalar>> = signals
-            .iter()
-            .map(|s| PeakSearch::new(Scalar::new(s, duration.max(0.0))))
-            .collect();
-        let mut knots = Vec::new();
-        self.on_grid(modal, channels, &grid, &mut |times, values, slopes| {
-            let rows = times.len();
-            for (c, search) in searches.iter_mut().enumerate() {
-                knots.clear();
-                knots.extend((0..rows).map(|i| (times[i], values[(i, c)], slopes[(i, c)])));
-                search.feed(&knots);
-            }
-            for (group, search) in groups.iter().zip(&mut norms) {
-                knots.clear();
-                knots.extend((0..rows).map(|i| {
-                    group.iter().fold((times[i], 0.0, 0.0), |(t, g, dg), &c| {
-                        let v = values[(i, c)];
-                        (t, g + v * v, dg + 2.0 * v * slopes[(i, c)])
-                    })
-                }));
-                search.feed(&knots);
-            }
-        });
+        // Each segment of the grid searched on its own, the searches then merged in time order.
+        let init = || {
+            let norms: Vec<PeakSearch<SquaredNorm>> = groups
+                .iter()
+                .map(|g| {
+                    let parts: Vec<&WaveSum> = g.iter().map(|&c| &signals[c]).collect();
+                    PeakSearch::new(SquaredNorm::new(&parts, duration.max(0.0)))
+                })
+                .collect();
+            let searches: Vec<PeakSearch<Scalar>> = signals
+                .iter()
+                .map(|s| PeakSearch::new(Scalar::new(s, duration.max(0.0))))
+                .collect();
+            (searches, norms, Vec::new())
+        };
+        let segments = self.on_grid_segments(
+            modal,
+            channels,
+            &grid,
+            init,
+            |(searches, norms, knots), times, values, slopes| {
+                let rows = times.len();
+                for (c, search) in searches.iter_mut().enumerate() {
+                    knots.clear();
+                    knots.extend((0..rows).map(|i| (times[i], values[(i, c)], slopes[(i, c)])));
+                    search.feed(knots);
+                }
+                for (group, search) in groups.iter().zip(norms.iter_mut()) {
+                    knots.clear();
+                    knots.extend((0..rows).map(|i| {
+                        group.iter().fold((times[i], 0.0, 0.0), |(t, g, dg), &c| {
+                            let v = values[(i, c)];
+                            (t, g + v * v, dg + 2.0 * v * slopes[(i, c)])
+                        })
+                    }));
+                    search.feed(knots);
+                }
+            },
+        );
+        let mut parts = segments.into_iter();
+        let (mut searches, mut norms, _) = parts.next().unwrap_or_else(init);
+        for (s, n, _) in parts {
+            searches = searches
+                .into_iter()
+                .zip(s)
+                .map(|(a, b)| a.merge(b))
+                .collect();
+            norms = norms.into_iter().zip(n).map(|(a, b)| a.merge(b)).collect();
+        }
         (
             searches.into_iter().map(PeakSearch::finish).collect(),
             norms
@@ -493,6 +550,13 @@ pub type GridPiece<'a> = dyn FnMut(&[f64], MatRef<'_, f64>, MatRef<'_, f64>) + '
 
 /// A peak |value| and its time (s after the hand-over).
 pub type Peak = (f64, f64);
+
+/// Grids longer than this many knots are walked in [`SEGMENTS`] segments side by side.
+const SEGMENT_KNOTS: usize = 100_000;
+
+/// The segments of a long grid ([`ModalResponse::on_grid_segments`]): a fixed count, so that
+/// the results are the same on any number of cores.
+const SEGMENTS: usize = 8;
 
 /// Grid intervals evaluated together in [`ModalResponse::peaks`].
 const PEAK_CHUNK: usize = 2048;
