@@ -48,6 +48,15 @@ pub enum Warning {
         /// The highest kept elastic frequency, Hz.
         highest_hz: f64,
     },
+    /// The deployment's output rate is below 2.5 times the fastest vibration its steps resolve
+    /// (the base's highest kept mode or a compliant latch's mode): deployment.csv's samples
+    /// alias that ringing, so the deployment's figures draw the solution's min/max envelope.
+    DeploymentAliasing {
+        /// `deployment.output_rate`, Hz.
+        output_rate: f64,
+        /// The fastest resolved vibration, Hz.
+        fastest_hz: f64,
+    },
     /// The response keeps every elastic mode (no `[response] modes`) up to a frequency whose
     /// exact peaks need a long closed-form search: its grid resolves the highest kept mode
     /// over the whole duration.
@@ -137,17 +146,7 @@ impl fmt::Display for Warning {
                 first_time,
                 min_angle,
                 initial_angle,
-            } => {
-                let into = if *hinge == 1 {
-                    "the hub".to_string()
-                } else {
-                    format!("panel {}", hinge - 1)
-                };
-                write!(
-                    f,
-                    "panel {hinge} swings back below its initial angle from t = {first_time:.6} s (minimum α_{hinge} = {min_angle:.6} rad, initial {initial_angle:.6} rad): the real array would collide with {into} there (no contact model)"
-                )
-            }
+            } => swing_back(f, *hinge, *first_time, *min_angle, *initial_angle),
             Self::Diverged { t } => write!(
                 f,
                 "the integration diverged (non-finite state) at t = {t} s and was stopped there"
@@ -173,6 +172,10 @@ impl fmt::Display for Warning {
                 output_rate,
                 highest_hz,
             } => aliasing(f, *output_rate, *highest_hz),
+            Self::DeploymentAliasing {
+                output_rate,
+                fastest_hz,
+            } => deployment_aliasing(f, *output_rate, *fastest_hz),
             Self::CostlyPeaks {
                 kept,
                 highest_hz,
@@ -254,6 +257,25 @@ impl fmt::Display for Warning {
     }
 }
 
+/// [`Warning::SwingBack`]'s text.
+fn swing_back(
+    f: &mut fmt::Formatter<'_>,
+    hinge: usize,
+    first_time: f64,
+    min_angle: f64,
+    initial_angle: f64,
+) -> fmt::Result {
+    let into = if hinge == 1 {
+        "the hub".to_string()
+    } else {
+        format!("panel {}", hinge - 1)
+    };
+    write!(
+        f,
+        "panel {hinge} swings back below its initial angle from t = {first_time:.6} s (minimum α_{hinge} = {min_angle:.6} rad, initial {initial_angle:.6} rad): the real array would collide with {into} there (no contact model)"
+    )
+}
+
 /// [`Warning::NoResponse`]'s text.
 const NO_RESPONSE: &str = "the array did not latch completely: no hand-over, no response";
 
@@ -280,6 +302,20 @@ fn costly_peaks(
          points per pass, most of this run's time); `[response] modes` keeps only the lowest \
          ones where the others do not matter",
         knots as f64 / 1e6
+    )
+}
+
+/// [`Warning::DeploymentAliasing`]'s text.
+fn deployment_aliasing(
+    f: &mut fmt::Formatter<'_>,
+    output_rate: f64,
+    fastest_hz: f64,
+) -> fmt::Result {
+    write!(
+        f,
+        "deployment.output_rate = {output_rate} Hz is below 2.5 times the fastest vibration the \
+         run resolves ({fastest_hz:.4} Hz): deployment.csv's samples alias it; the deployment's \
+         figures draw the solution's min/max envelope and every peak is the solution's"
     )
 }
 

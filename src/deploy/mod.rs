@@ -10,6 +10,7 @@ pub mod auto;
 pub mod base;
 pub mod chain;
 pub mod coupled;
+pub mod envelope;
 pub(crate) mod events;
 pub mod inertia;
 pub mod loads;
@@ -395,6 +396,9 @@ pub struct DeploymentResult {
     /// The same peaks from the first impact or capture on: the latch-ups' loads, apart from
     /// the release's transient.
     pub latch_up_peaks: Vec<peaks::Peak>,
+    /// Where the output rate aliases the ringing the run resolves: the plotted quantities'
+    /// min/max per plot column over every state the run computed ([`envelope`]).
+    pub envelope: Option<envelope::Envelope>,
     /// Peaks of the engine's tracked load magnitudes ([`peaks`]), observed at every step
     /// (coupled model: every hinge's latch moment, then every base beam's root force and
     /// root moment, then every hinge's reaction force, every hinge's transmitted moment, and

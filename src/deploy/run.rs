@@ -5,6 +5,7 @@
 //! ([`super::coupled::Coupled`]).
 
 use super::chain::{Chain, Hinge, PlanarHub, FRICTION_RATE, P2};
+use super::envelope::{Envelope, Trace};
 use super::events::{self, Crossing};
 use super::peaks::PeakTracker;
 use super::swing::SwingTracker;
@@ -566,6 +567,8 @@ struct Run<'a, E: Engine> {
     /// The latest two steps' dense outputs (the older first), from which the peak trackers'
     /// candidates are evaluated ([`PeakTracker::resolve`]).
     dense: [Option<DenseStep>; 2],
+    /// The plotted quantities' envelope, where the output rate aliases the ringing.
+    envelope: Option<Envelope>,
 }
 
 impl<'a, E: Engine> Run<'a, E> {
@@ -578,6 +581,10 @@ impl<'a, E: Engine> Run<'a, E> {
             captured: vec![false; hinges.len()],
         };
         let samples = vec![engine.sample(0.0, &y, &sys.free, &sys.captured)];
+        let envelope = s
+            .record_samples
+            .then(|| envelope_of(engine, &samples[0], s))
+            .flatten();
         let mut peaks = PeakTracker::default();
         peaks.observe(0.0, &engine.load_magnitudes(&y, &sys.free, &sys.captured));
         let len = y.len();
@@ -604,6 +611,7 @@ impl<'a, E: Engine> Run<'a, E> {
             latch_up: None,
             resolved: true,
             dense: [None, None],
+            envelope,
         }
         .with_phase()
     }
@@ -921,20 +929,33 @@ impl<'a, E: Engine> Run<'a, E> {
         self.solver.conserve(&self.sys, &mut self.y);
         self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
-            self.samples
-                .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
+            let sample = engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured);
+            self.record(sample);
         }
         self.solver.restart();
         self.start_latch_up(e.t);
     }
 
-    /// Observes the tracked load magnitudes at the current state.
+    /// Observes the tracked load magnitudes at the current state (and the plotted
+    /// quantities, where they are enveloped).
     fn observe_loads(&mut self) {
         let m = self
             .sys
             .engine
             .load_magnitudes(&self.y, &self.sys.free, &self.sys.captured);
         self.observe(self.t, &m);
+        if let Some(env) = &mut self.envelope {
+            let e = self.sys.engine;
+            env.observe(&e.sample(self.t, &self.y, &self.sys.free, &self.sys.captured));
+        }
+    }
+
+    /// Keeps an output sample (and takes it into the envelope).
+    fn record(&mut self, sample: Sample) {
+        if let Some(env) = &mut self.envelope {
+            env.observe(&sample);
+        }
+        self.samples.push(sample);
     }
 
     /// Observes the load magnitudes `m` at t: with a parabola through the latest three
@@ -1039,6 +1060,10 @@ impl<'a, E: Engine> Run<'a, E> {
                         .engine
                         .load_magnitudes(&self.buf, &self.sys.free, &self.sys.captured);
                 self.observe(ti, &m);
+                if let Some(env) = &mut self.envelope {
+                    let e = self.sys.engine;
+                    env.observe(&e.sample(ti, &self.buf, &self.sys.free, &self.sys.captured));
+                }
             }
             if !due {
                 break;
@@ -1056,12 +1081,8 @@ impl<'a, E: Engine> Run<'a, E> {
             // The load peaks are not observed at the samples: they come from the steps
             // (and the points inside them), so that they do not move with the output rate.
             if self.s.record_samples {
-                self.samples.push(self.sys.engine.sample(
-                    tk,
-                    &self.buf,
-                    &self.sys.free,
-                    &self.sys.captured,
-                ));
+                let e = self.sys.engine;
+                self.record(e.sample(tk, &self.buf, &self.sys.free, &self.sys.captured));
             }
             self.next_k += 1;
         }
@@ -1129,10 +1150,9 @@ impl<'a, E: Engine> Run<'a, E> {
         self.sys.free = free_after;
         self.observe_loads();
         if self.samples.last().is_none_or(|s| s.t < e.t) {
-            self.samples.push(before);
+            self.record(before);
         }
-        self.samples
-            .push(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
+        self.record(engine.sample(e.t, &self.y, &self.sys.free, &self.sys.captured));
         self.solver.restart();
         self.set_phase();
     }
@@ -1190,6 +1210,12 @@ impl<'a, E: Engine> Run<'a, E> {
             }
         }
         warnings.extend(swing_warnings);
+        if let Some(e) = &self.envelope {
+            warnings.push(Warning::DeploymentAliasing {
+                output_rate: e.output_rate,
+                fastest_hz: e.fastest_hz,
+            });
+        }
         match status {
             RunStatus::Diverged { t } => warnings.push(Warning::Diverged { t }),
             RunStatus::StepLimit { t } => warnings.push(Warning::StepLimit { t }),
@@ -1241,8 +1267,38 @@ impl<'a, E: Engine> Run<'a, E> {
             accuracy: None,
             load_peaks: self.peaks.peaks().to_vec(),
             latch_up_peaks: self.latch_up_peaks.peaks().to_vec(),
+            envelope: self.envelope,
         }
     }
+}
+
+/// The envelope of a run of `engine` whose first sample is `first`: every hinge's rate and
+/// reaction (and latch moment, compliant latches), every base beam's root force and moment,
+/// the first six base modal coordinates — where the output rate is below
+/// [`super::envelope::ALIAS_FACTOR`] times the fastest vibration the run resolves: the
+/// base's highest kept mode, or a compliant latch's mode.
+fn envelope_of<E: Engine>(engine: &E, first: &Sample, s: &RunSettings) -> Option<Envelope> {
+    let latch = engine.latch_period();
+    let latch_omega = if latch > 0.0 {
+        2.0 * std::f64::consts::PI / latch
+    } else {
+        0.0
+    };
+    let fastest = engine.base_resolved().max(latch_omega) / (2.0 * std::f64::consts::PI);
+    let n = engine.hinges().len();
+    let mut traces: Vec<Trace> = (0..n).map(Trace::Rate).collect();
+    traces.extend((0..n).map(Trace::Reaction));
+    if engine.compliant() {
+        traces.extend((0..n).map(Trace::LatchMoment));
+    }
+    if let Some(b) = first.body.as_deref() {
+        traces.extend((0..b.root_loads.len()).map(Trace::RootForce));
+        traces.extend((0..b.root_loads.len()).map(Trace::RootMoment));
+        traces.extend((0..b.eta.len().min(6)).map(Trace::Eta));
+    }
+    let mut env = Envelope::new(traces, s.end_time, s.output_rate, fastest)?;
+    env.observe(first);
+    Some(env)
 }
 
 /// The scheduled stepper's longest step, as a fraction of the end time, at the first

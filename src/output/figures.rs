@@ -1,6 +1,7 @@
 //! The figures of the deployment and of the response, defined once: drawn as PNG+SVG files
 //! ([`super::plot::line_chart`]) and as interactive charts in the HTML report.
 
+use crate::deploy::envelope::{Envelope, Trace};
 use crate::deploy::{Deployment, DeploymentResult, Sample};
 use crate::response::{Channel, ChannelKind};
 use crate::ritz::ModalAnalysis;
@@ -248,11 +249,18 @@ pub fn deployment_figures(
     markers.extend(r.captures.iter().map(|c| c.time));
     markers.sort_by(f64::total_cmp);
     markers.dedup();
-    let per_hinge = |f: &dyn Fn(&Sample, usize) -> f64| -> Vec<Curve> {
+    let env = r.envelope.as_ref();
+    // Hinge i's samples, or its envelope from the solution where the samples alias.
+    let per_hinge = |f: &dyn Fn(&Sample, usize) -> f64, trace: Option<fn(usize) -> Trace>| {
         shown
             .iter()
-            .map(|&i| curve(format!("hinge {}", i + 1), m, t, |k| f(&r.samples[k], i)))
-            .collect()
+            .map(|&i| {
+                let name = format!("hinge {}", i + 1);
+                traced(env, trace.map(|tr| tr(i)), name, m, t, |k| {
+                    f(&r.samples[k], i)
+                })
+            })
+            .collect::<Vec<Curve>>()
     };
     let fig = |stem: &str, title: &str, ylabel: &'static str, curves| Figure {
         stem: stem.into(),
@@ -262,33 +270,38 @@ pub fn deployment_figures(
         curves,
         markers: markers.clone(),
     };
+    // The figures drawn from the envelope say so.
+    let enveloped = |title: &str| deployment_title(title, env);
     let body = |k: usize| r.samples[k].body.as_deref();
     let mut figs = vec![
         fig(
             "angles",
             "opening angles",
             "α [rad]",
-            per_hinge(&|s, i| s.alpha[i]),
+            per_hinge(&|s, i| s.alpha[i], None),
         ),
         fig(
             "rates",
-            "opening rates",
+            &enveloped("opening rates"),
             "α̇ [rad/s]",
-            per_hinge(&|s, i| s.rate[i]),
+            per_hinge(&|s, i| s.rate[i], Some(Trace::Rate)),
         ),
         fig(
             "reactions",
-            "hinge reaction force magnitude (inboard body on panel i)",
+            &enveloped("hinge reaction force magnitude (inboard body on panel i)"),
             "|F| [N]",
-            per_hinge(&|s, i| s.force[i][0].hypot(s.force[i][1])),
+            per_hinge(
+                &|s, i| s.force[i][0].hypot(s.force[i][1]),
+                Some(Trace::Reaction),
+            ),
         ),
     ];
     if !r.captures.is_empty() {
         figs.push(fig(
             "latch_moments",
-            "compliant latch moments on the hinges (captures marked)",
+            &enveloped("compliant latch moments on the hinges (captures marked)"),
             "M_L [N·m]",
-            per_hinge(&|s, i| s.latch_moment[i]),
+            per_hinge(&|s, i| s.latch_moment[i], Some(Trace::LatchMoment)),
         ));
     }
     if body(0).is_none() {
@@ -359,30 +372,31 @@ fn body_figures(r: &DeploymentResult, beam_names: &[String], markers: &[f64]) ->
             .cloned()
             .unwrap_or_else(|| format!("beam {}", b + 1))
     };
+    let env = r.envelope.as_ref();
     if beams > 0 {
         let moments: Vec<Curve> = (0..beams)
             .map(|b| {
-                curve(names(b), m, t, |k| {
+                traced(env, Some(Trace::RootMoment(b)), names(b), m, t, |k| {
                     comp(&|s| norm(&s.root_loads[b][3..6]), k)
                 })
             })
             .collect();
         figs.push(fig(
             "root_moments",
-            "beam root moment magnitude (parent on beam)",
+            &deployment_title("beam root moment magnitude (parent on beam)", env),
             "|M| [N·m]",
             moments,
         ));
         let forces: Vec<Curve> = (0..beams)
             .map(|b| {
-                curve(names(b), m, t, |k| {
+                traced(env, Some(Trace::RootForce(b)), names(b), m, t, |k| {
                     comp(&|s| norm(&s.root_loads[b][0..3]), k)
                 })
             })
             .collect();
         figs.push(fig(
             "root_forces",
-            "beam root force magnitude (parent on beam)",
+            &deployment_title("beam root force magnitude (parent on beam)", env),
             "|F| [N]",
             forces,
         ));
@@ -391,14 +405,15 @@ fn body_figures(r: &DeploymentResult, beam_names: &[String], markers: &[f64]) ->
     if modes > 0 {
         let eta: Vec<Curve> = (0..modes)
             .map(|j| {
-                curve(format!("base mode {}", j + 1), m, t, |k| {
+                let name = format!("base mode {}", j + 1);
+                traced(env, Some(Trace::Eta(j)), name, m, t, |k| {
                     comp(&|s| s.eta[j], k)
                 })
             })
             .collect();
         figs.push(fig(
             "base_modes",
-            "base modal coordinates (hub-fixed modes)",
+            &deployment_title("base modal coordinates (hub-fixed modes)", env),
             "η [√kg·m]",
             eta,
         ));
@@ -520,6 +535,37 @@ pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Ve
     out
 }
 
+/// A deployment quantity: its envelope from the solution where the run kept one for
+/// `trace`, else its samples `0..n` (decimated).
+fn traced(
+    env: Option<&Envelope>,
+    trace: Option<Trace>,
+    name: String,
+    n: usize,
+    x: impl Fn(usize) -> f64,
+    y: impl Fn(usize) -> f64,
+) -> Curve {
+    match env.zip(trace).and_then(|(e, tr)| e.points(tr)) {
+        Some(points) => (
+            name,
+            points.iter().map(|p| p.0).collect(),
+            points.iter().map(|p| p.1).collect(),
+        ),
+        None => curve(name, n, x, y),
+    }
+}
+
+/// A deployment figure's title, saying when it draws the solution's envelope.
+fn deployment_title(title: &str, env: Option<&Envelope>) -> String {
+    match env {
+        Some(e) => format!(
+            "{title} — min/max envelope ({} Hz samples alias {:.3} Hz)",
+            e.output_rate, e.fastest_hz
+        ),
+        None => title.to_string(),
+    }
+}
+
 /// Response channel `j`: its samples (decimated), or its min/max envelope from the solution
 /// where the samples would alias.
 fn channel_curve(r: &Response, env: Option<&[Vec<(f64, f64)>]>, j: usize, c: &Channel) -> Curve {
@@ -544,9 +590,7 @@ fn channel_curve(r: &Response, env: Option<&[Vec<(f64, f64)>]>, j: usize, c: &Ch
 /// A response figure's title, saying when it draws the solution's envelope.
 fn envelope_title(title: String, env: Option<&[Vec<(f64, f64)>]>) -> String {
     if env.is_some() {
-        format!(
-            "{title} — min/max envelope of the solution (the output rate is below 2.5× the highest kept mode)"
-        )
+        format!("{title} — min/max envelope of the solution (the samples alias)")
     } else {
         title
     }

@@ -368,6 +368,14 @@ fn draw_legend<DB: DrawingBackend>(
     Ok(())
 }
 
+/// The caption's font size (px) that fits `title` in `width` px: 20 px, smaller for a long
+/// title (a sans-serif glyph is ~0.55 of the size wide on average), never below 12 px.
+fn caption_size(title: &str, width: u32) -> u32 {
+    let chars = title.chars().count().max(1) as f64;
+    let fit = (width.saturating_sub(24) as f64 / (0.55 * chars)).floor();
+    (fit as u32).clamp(12, 20)
+}
+
 fn draw_chart<DB: DrawingBackend>(
     root: DrawingArea<DB, Shift>,
     title: &str,
@@ -423,7 +431,7 @@ fn draw_chart<DB: DrawingBackend>(
     let (ya, yb) = (y0 - pad, y1 + pad);
     let (xr, yr) = (x1 - x0, yb - ya);
     let mut chart = ChartBuilder::on(&plot_area)
-        .caption(title, ("sans-serif", 20))
+        .caption(title, ("sans-serif", caption_size(title, w - legend_w)))
         .margin(12)
         .x_label_area_size(44)
         .y_label_area_size(76)

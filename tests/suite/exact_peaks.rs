@@ -230,3 +230,92 @@ fn the_envelope_holds_every_sample_and_reaches_the_peak() {
         );
     }
 }
+
+#[test]
+fn the_deployment_envelope_follows_the_ringing_the_samples_alias() {
+    // seed_compliant's deployment samples at 10 Hz while its latches ring at 74 Hz: the
+    // figures draw the envelope of every state the run computed. The same run at 400 Hz
+    // (above 2.5 × 74 Hz: no envelope, the samples resolve the ringing) is the same solution
+    // sampled finely (the steps do not depend on the output rate): every one of its samples
+    // must lie within the 10 Hz envelope's column, to the steps' resolution of the ringing
+    // (several points a period: a crest missed by at most ~3 % of the amplitude), and the
+    // envelope must reach the run's tracked peak of the root moment without passing it.
+    use flexcraft::deploy::envelope::{Trace, COLUMNS};
+    let src = include_str!("../../examples/seed_compliant.toml");
+    let at = |rate: f64| {
+        let s = src.replace("output_rate = 10.0", &format!("output_rate = {rate}"));
+        assert_ne!(s, src);
+        Simulation::run(&scenario(&s)).expect("simulate").deployment
+    };
+    let (coarse, fine) = (at(10.0), at(400.0));
+    assert!(fine.envelope.is_none());
+    assert!(!fine
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains("deployment.output_rate")));
+    assert!(coarse
+        .warnings
+        .iter()
+        .any(|w| w.to_string().contains("deployment.output_rate")));
+    let env = coarse.envelope.as_ref().expect("10 Hz aliases the latches");
+    let end = env.end_time;
+    // Not the root force: right after the capture it carries the static correction's
+    // quasi-static response, which the steps do not resolve and the 400 Hz samples read from
+    // the steps' interpolant (docs/theory.md §2.9: root loads estimated, not bounded).
+    let traces = [
+        Trace::RootMoment(0),
+        Trace::LatchMoment(0),
+        Trace::LatchMoment(2),
+        Trace::Rate(1),
+        // Base mode 1 bends the mast out of the deployment plane: zero by symmetry.
+        Trace::Eta(1),
+    ];
+    for trace in traces {
+        let pts = env.points(trace).expect("kept");
+        // Per column: the envelope's lowest and highest value.
+        let column = |t: f64| ((t / end * COLUMNS as f64) as usize).min(COLUMNS - 1);
+        let mut cols = vec![(f64::INFINITY, f64::NEG_INFINITY); COLUMNS];
+        for &(t, v) in &pts {
+            let c = &mut cols[column(t)];
+            *c = (c.0.min(v), c.1.max(v));
+        }
+        // A column the run did not step in (a long step of the slow swing, before the first
+        // capture) is drawn as the line between its neighbours: their extremes bound it.
+        let filled: Vec<usize> = (0..COLUMNS).filter(|&c| cols[c].0.is_finite()).collect();
+        let bounds = |c: usize| -> (f64, f64) {
+            if cols[c].0.is_finite() {
+                return cols[c];
+            }
+            let right = filled.partition_point(|&f| f < c);
+            let mut b = (f64::INFINITY, f64::NEG_INFINITY);
+            for k in [right.wrapping_sub(1), right] {
+                if let Some(&f) = filled.get(k) {
+                    b = (b.0.min(cols[f].0), b.1.max(cols[f].1));
+                }
+            }
+            b
+        };
+        let amplitude = pts.iter().fold(0.0_f64, |m, p| m.max(p.1.abs()));
+        assert!(amplitude > 0.0, "{trace:?}");
+        let mut inside = 0;
+        for s in &fine.samples {
+            let v = trace.value(s);
+            let (lo, hi) = bounds(column(s.t));
+            assert!(
+                v >= lo - 0.04 * amplitude && v <= hi + 0.04 * amplitude,
+                "{trace:?} at t = {}: sample {v} outside [{lo}, {hi}] (amplitude {amplitude})",
+                s.t
+            );
+            inside += 1;
+        }
+        assert!(inside > 20_000, "{inside}");
+    }
+    // The root moment's envelope reaches the tracked peak (hinges 3, then root force and
+    // moment of the mast) to the steps' resolution, never beyond it.
+    let peak = coarse.load_peaks[4].0;
+    let (drawn, _) = env.largest(Trace::RootMoment(0)).expect("kept");
+    assert!(
+        drawn <= peak * (1.0 + 1e-9) && drawn >= 0.97 * peak,
+        "{drawn} vs {peak}"
+    );
+}
