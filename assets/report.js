@@ -91,7 +91,10 @@
       var sx = function (x) { return L + (x - view[0]) / (view[1] - view[0] || 1) * (W - L - R); };
       var sy = function (y) { return H - B - (y - ylo) / (yhi - ylo) * (H - T - B); };
       chart.sx = sx; chart.sy = sy;
-      text(svg, W / 2, 18, spec.title, "middle", "title");
+      // A long title is drawn smaller, never beyond the chart (nor below 9 px).
+      var title = text(svg, W / 2, 18, spec.title, "middle", "title");
+      var tw = title.getComputedTextLength ? title.getComputedTextLength() : 0;
+      if (tw > W - 20) title.style.fontSize = Math.max(9, 14 * (W - 20) / tw).toFixed(1) + "px";
       var xt = ticks(view[0], view[1], 8), xstep = xt.length > 1 ? xt[1] - xt[0] : 1;
       xt.forEach(function (v) {
         el("line", { x1: sx(v), x2: sx(v), y1: T, y2: H - B, "class": "grid" }, svg);

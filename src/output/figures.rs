@@ -509,6 +509,25 @@ pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Ve
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));
     out.extend(load_figures(s, r, &stems, env));
+    // Each history followed by its amplitude spectrum.
+    let spectra = r.modal.spectrum(modes, &r.channels);
+    // A channel whose every amplitude is rounding against its quantity's largest names no
+    // mode (the rule of `clean`, which also draws its lines as zero).
+    let largest = |j: usize| spectra[j].iter().fold(0.0_f64, |m, l| m.max(l.1));
+    let mut noise = NoiseReference::new(structure_size(st));
+    for (j, c) in r.channels.iter().enumerate() {
+        noise.observe(c.unit, largest(j));
+    }
+    let carries: Vec<bool> = (0..r.channels.len())
+        .map(|j| largest(j) > 0.0 && !noise.is_noise(r.channels[j].unit, largest(j)))
+        .collect();
+    let mut out: Vec<Figure> = out
+        .into_iter()
+        .flat_map(|f| {
+            let sp = spectrum_figure(&f, r, &spectra, &carries);
+            std::iter::once(f).chain(sp)
+        })
+        .collect();
     let modal: Vec<Curve> = r
         .modal
         .modes
@@ -533,6 +552,76 @@ pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Ve
     ));
     clean(&mut out, structure_size(st));
     out
+}
+
+/// The amplitude spectrum of a response history figure `f` (its curves are channels, by
+/// label): per channel, a line from zero up to each kept mode's amplitude at the mode's
+/// frequency ([`crate::response::ModalResponse::spectrum`]), the title naming the modes that
+/// carry the most among the channels flagged in `carries`. None for a figure whose curves
+/// are not channels.
+fn spectrum_figure(
+    f: &Figure,
+    r: &Response,
+    spectra: &[Vec<(f64, f64, usize)>],
+    carries: &[bool],
+) -> Option<Figure> {
+    let idx: Vec<usize> = f
+        .curves
+        .iter()
+        .map(|c| r.channels.iter().position(|ch| ch.label == c.0))
+        .collect::<Option<_>>()?;
+    if idx.is_empty() {
+        return None;
+    }
+    let curves: Vec<Curve> = idx
+        .iter()
+        .map(|&j| {
+            let mut lines = spectra[j].clone();
+            lines.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let xs = lines.iter().flat_map(|l| [l.0, l.0, l.0]).collect();
+            let ys = lines.iter().flat_map(|l| [0.0, l.1, 0.0]).collect();
+            (format!("{}: amplitude", r.channels[j].label), xs, ys)
+        })
+        .collect();
+    // The three modes with the largest amplitude in any of the figure's channels.
+    let mut top: Vec<(f64, f64, usize)> = Vec::new();
+    for &j in idx.iter().filter(|&&j| carries[j]) {
+        for &(hz, a, n) in &spectra[j] {
+            match top.iter_mut().find(|t| t.2 == n) {
+                Some(t) => t.1 = t.1.max(a),
+                None => top.push((hz, a, n)),
+            }
+        }
+    }
+    top.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let carriers: Vec<String> = top
+        .iter()
+        .take(3)
+        .filter(|t| t.1 > 0.0)
+        .map(|t| {
+            // Four significant digits.
+            let decimals = (3 - t.0.abs().log10().floor() as i32).clamp(0, 6) as usize;
+            format!("{:.*}", decimals, t.0)
+        })
+        .collect();
+    // The history's title without its envelope note and its parenthesis.
+    let base = f.title.split(" — ").next().unwrap_or(&f.title);
+    let base = base.split(" (").next().unwrap_or(base);
+    Some(Figure {
+        stem: format!("{}_spectrum", f.stem),
+        title: if carriers.is_empty() {
+            format!("{base}: amplitude of each kept mode (none: rounding only)")
+        } else {
+            format!(
+                "{base}: amplitude of each kept mode (largest at {} Hz)",
+                carriers.join(", ")
+            )
+        },
+        xlabel: "f [Hz]",
+        ylabel: f.ylabel,
+        curves,
+        markers: Vec::new(),
+    })
 }
 
 /// A deployment quantity: its envelope from the solution where the run kept one for

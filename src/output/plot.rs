@@ -369,11 +369,11 @@ fn draw_legend<DB: DrawingBackend>(
 }
 
 /// The caption's font size (px) that fits `title` in `width` px: 20 px, smaller for a long
-/// title (a sans-serif glyph is ~0.55 of the size wide on average), never below 12 px.
+/// title (a sans-serif glyph is ~0.55 of the size wide on average), never below 10 px.
 fn caption_size(title: &str, width: u32) -> u32 {
     let chars = title.chars().count().max(1) as f64;
     let fit = (width.saturating_sub(24) as f64 / (0.55 * chars)).floor();
-    (fit as u32).clamp(12, 20)
+    (fit as u32).clamp(10, 20)
 }
 
 fn draw_chart<DB: DrawingBackend>(

@@ -253,6 +253,33 @@ impl ModalResponse {
             .collect()
     }
 
+    /// Each channel's amplitude spectrum: for every kept elastic mode, in the modes' order,
+    /// (its damped frequency in Hz, the amplitude √(p² + q²) of its contribution to the
+    /// channel at the hand-over, the mode's number). The channel is its offset and rigid part
+    /// plus the sum of these sinusoids, each decaying as e^{−ζωt}: the modes that carry it.
+    pub fn spectrum(
+        &self,
+        modal: &ModalAnalysis,
+        channels: &[Channel],
+    ) -> Vec<Vec<(f64, f64, usize)>> {
+        let elastic: Vec<usize> = self
+            .modes
+            .iter()
+            .filter(|m| !(m.rigid || m.omega_rad_s == 0.0))
+            .map(|m| m.number)
+            .collect();
+        self.signals(modal, channels)
+            .iter()
+            .map(|s| {
+                s.waves
+                    .iter()
+                    .zip(&elastic)
+                    .map(|(w, &n)| (w.omega / (2.0 * std::f64::consts::PI), w.modulus(), n))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Every channel's value (offset included) and slope on the uniform `grid` (t_i = i·h),
     /// in consecutive pieces that share their end rows: `f(times, values, slopes)` with
     /// rows × channels matrices. The modes are evaluated on the grid and the channels from
