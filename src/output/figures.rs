@@ -509,25 +509,7 @@ pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Ve
         pick(&|c| c.kind == ChannelKind::HubRotation),
     ));
     out.extend(load_figures(s, r, &stems, env));
-    // Each history followed by its amplitude spectrum.
-    let spectra = r.modal.spectrum(modes, &r.channels);
-    // A channel whose every amplitude is rounding against its quantity's largest names no
-    // mode (the rule of `clean`, which also draws its lines as zero).
-    let largest = |j: usize| spectra[j].iter().fold(0.0_f64, |m, l| m.max(l.1));
-    let mut noise = NoiseReference::new(structure_size(st));
-    for (j, c) in r.channels.iter().enumerate() {
-        noise.observe(c.unit, largest(j));
-    }
-    let carries: Vec<bool> = (0..r.channels.len())
-        .map(|j| largest(j) > 0.0 && !noise.is_noise(r.channels[j].unit, largest(j)))
-        .collect();
-    let mut out: Vec<Figure> = out
-        .into_iter()
-        .flat_map(|f| {
-            let sp = spectrum_figure(&f, r, &spectra, &carries);
-            std::iter::once(f).chain(sp)
-        })
-        .collect();
+    let mut out = with_spectra(out, r, modes, structure_size(st));
     let modal: Vec<Curve> = r
         .modal
         .modes
@@ -552,6 +534,28 @@ pub fn response_figures(s: &Scenario, r: &Response, modes: &ModalAnalysis) -> Ve
     ));
     clean(&mut out, structure_size(st));
     out
+}
+
+/// The response's history figures `out`, each followed by its amplitude spectrum
+/// ([`spectrum_figure`]); `size` is the structure's, for the noise rule.
+fn with_spectra(out: Vec<Figure>, r: &Response, modes: &ModalAnalysis, size: f64) -> Vec<Figure> {
+    let spectra = r.modal.spectrum(modes, &r.channels);
+    // A channel whose every amplitude is rounding against its quantity's largest names no
+    // mode (the rule of `clean`, which also draws its lines as zero).
+    let largest = |j: usize| spectra[j].iter().fold(0.0_f64, |m, l| m.max(l.1));
+    let mut noise = NoiseReference::new(size);
+    for (j, c) in r.channels.iter().enumerate() {
+        noise.observe(c.unit, largest(j));
+    }
+    let carries: Vec<bool> = (0..r.channels.len())
+        .map(|j| largest(j) > 0.0 && !noise.is_noise(r.channels[j].unit, largest(j)))
+        .collect();
+    out.into_iter()
+        .flat_map(|f| {
+            let sp = spectrum_figure(&f, r, &spectra, &carries);
+            std::iter::once(f).chain(sp)
+        })
+        .collect()
 }
 
 /// The amplitude spectrum of a response history figure `f` (its curves are channels, by
