@@ -49,8 +49,9 @@ pub enum Warning {
         highest_hz: f64,
     },
     /// The deployment's output rate is below 2.5 times the fastest vibration its steps resolve
-    /// (the base's highest kept mode or a compliant latch's mode): deployment.csv's samples
-    /// alias that ringing, so the deployment's figures draw the solution's min/max envelope.
+    /// (the base's highest kept mode or the captured array's fastest mode on its latch
+    /// springs): deployment.csv's samples alias that ringing, so the deployment's figures draw
+    /// the solution's min/max envelope.
     DeploymentAliasing {
         /// `deployment.output_rate`, Hz.
         output_rate: f64,

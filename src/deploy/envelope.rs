@@ -5,7 +5,7 @@
 //! tens of hertz; a deployment sampled at a few hertz aliases that ringing into a slow beat
 //! (a mast ringing at ~20 Hz read at 10 Hz shows a 0.17 Hz oscillation that is not there).
 //! Where the output rate is below 2.5 times the fastest vibration the run resolves, the run
-//! therefore keeps, per plot column of `[0, end_time]`, the smallest and largest value of
+//! therefore keeps, per plot column of the time it reaches, the smallest and largest value of
 //! each plotted quantity over every state it computes — each step's end, the points inside
 //! the steps where it observes the loads, every event and every sample — and the figures
 //! draw that envelope instead of the samples. The steps resolve the ringing they carry
@@ -55,6 +55,11 @@ impl Trace {
 type Extremes = ((f64, f64), (f64, f64));
 
 /// The envelope of a run's plotted quantities.
+///
+/// Its columns are [k w, (k + 1) w) for k < [`COLUMNS`]; the width w starts at
+/// end_time / (COLUMNS · 2^[`FINE`]) and doubles (neighbouring columns merged) whenever an
+/// observation falls beyond the last column, so that a run that ends long before its
+/// `end_time` (a final latch at 30 s of 300 s) still spreads over half the columns at least.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Envelope {
     /// The fastest vibration the run resolves, Hz (what the samples alias).
@@ -63,14 +68,28 @@ pub struct Envelope {
     pub output_rate: f64,
     /// The quantities kept.
     pub traces: Vec<Trace>,
-    /// The columns span [0, end_time] (`deployment.end_time`: the run may end before it), s.
-    pub end_time: f64,
+    /// The columns' width w, s.
+    width: f64,
     /// Per trace, per column.
     columns: Vec<Vec<Extremes>>,
 }
 
 /// Plot columns of the envelope (the figures are 1 600 px wide at most).
 pub const COLUMNS: usize = 2000;
+
+/// The first columns are 2^FINE times narrower than `end_time / COLUMNS`.
+pub const FINE: i32 = 12;
+
+/// An empty column.
+const EMPTY: Extremes = ((f64::NAN, f64::INFINITY), (f64::NAN, f64::NEG_INFINITY));
+
+/// The extremes of two columns together (the earlier one's on a tie).
+fn merged(a: Extremes, b: Extremes) -> Extremes {
+    (
+        if b.0 .1 < a.0 .1 { b.0 } else { a.0 },
+        if b.1 .1 > a.1 .1 { b.1 } else { a.1 },
+    )
+}
 
 /// The samples alias a vibration when the output rate is below this many times its
 /// frequency.
@@ -86,19 +105,38 @@ impl Envelope {
         fastest_hz: f64,
     ) -> Option<Self> {
         let needed = fastest_hz > 0.0 && output_rate < ALIAS_FACTOR * fastest_hz;
-        let empty = ((f64::NAN, f64::INFINITY), (f64::NAN, f64::NEG_INFINITY));
         (needed && !traces.is_empty() && end_time > 0.0).then(|| Self {
             fastest_hz,
             output_rate,
-            columns: vec![vec![empty; COLUMNS]; traces.len()],
+            columns: vec![vec![EMPTY; COLUMNS]; traces.len()],
             traces,
-            end_time,
+            width: end_time / COLUMNS as f64 / 2f64.powi(FINE),
         })
+    }
+
+    /// The columns' current width, s.
+    pub fn width(&self) -> f64 {
+        self.width
+    }
+
+    /// The column of time t (≥ 0) at the current width.
+    pub fn column(&self, t: f64) -> usize {
+        ((t / self.width).max(0.0) as usize).min(COLUMNS - 1)
     }
 
     /// Takes in the state `s` the run computed (at `s.t`).
     pub fn observe(&mut self, s: &Sample) {
-        let c = ((s.t / self.end_time * COLUMNS as f64).max(0.0) as usize).min(COLUMNS - 1);
+        // Past the last column: neighbouring columns merged, the width doubled.
+        while s.t >= self.width * COLUMNS as f64 && self.width.is_finite() {
+            for cols in &mut self.columns {
+                for k in 0..COLUMNS / 2 {
+                    cols[k] = merged(cols[2 * k], cols[2 * k + 1]);
+                }
+                cols[COLUMNS / 2..].fill(EMPTY);
+            }
+            self.width *= 2.0;
+        }
+        let c = self.column(s.t);
         for (trace, cols) in self.traces.iter().zip(&mut self.columns) {
             let v = trace.value(s);
             if !v.is_finite() {
@@ -167,23 +205,49 @@ mod tests {
 
     #[test]
     fn a_sine_above_the_output_rate_keeps_its_amplitude_in_every_column() {
-        // 20 Hz observed at 400 points a second over 10 s, 2 000 columns of 5 ms: every
-        // column's extremes lie on the sine, and columns that span a crest reach ±1 to the
-        // observation's resolution, where 10 Hz samples would read sin(2π·2k) = 0 throughout.
+        // 20 Hz observed at 4 000 points a second over 10 s of a run whose end time is 100 s:
+        // the columns narrow to the 10 s reached (width doubled from 100 s / 2000 / 4096 up
+        // to between 2.5 and 5 ms: more than 2 000 points). Every column's extremes lie on
+        // the sine; a column that spans a crest (or a trough) reaches +1 (−1) to the
+        // observations' resolution (200 points a period: 1 − cos(π/200) ≈ 1.2e-4), where
+        // 10 Hz samples would read sin(2π·2k) = 0 throughout.
         let f = 20.0;
-        let mut env = Envelope::new(vec![Trace::Rate(0)], 10.0, 10.0, f).expect("aliased");
-        for k in 0..=4000 {
-            let t = k as f64 / 400.0;
-            env.observe(&sample(t, (2.0 * std::f64::consts::PI * f * t).sin()));
+        let w = 2.0 * std::f64::consts::PI * f;
+        let mut env = Envelope::new(vec![Trace::Rate(0)], 100.0, 10.0, f).expect("aliased");
+        for k in 0..=40_000 {
+            let t = k as f64 / 4000.0;
+            env.observe(&sample(t, (w * t).sin()));
         }
         let pts = env.points(Trace::Rate(0)).expect("kept");
+        assert!(pts.len() > 2 * COLUMNS / 2, "{} points", pts.len());
         for &(t, v) in &pts {
-            assert!((v - (2.0 * std::f64::consts::PI * f * t).sin()).abs() < 1e-9);
+            assert!((v - (w * t).sin()).abs() < 1e-9);
         }
-        let (hi, _) = env.largest(Trace::Rate(0)).expect("kept");
-        let lo = pts.iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
-        // 20 points a period: the best observation within (π/20)²/2 of the crest.
-        assert!(hi > 1.0 - 0.013 && lo < -1.0 + 0.013, "{hi} {lo}");
+        // Per column, its extremes against the sine's over the column's span.
+        let mut cols = std::collections::BTreeMap::new();
+        for &(t, v) in &pts {
+            let e = cols
+                .entry(env.column(t))
+                .or_insert((f64::INFINITY, f64::NEG_INFINITY));
+            *e = (e.0.min(v), e.1.max(v));
+        }
+        let width = env.width();
+        assert!(cols.len() >= COLUMNS / 2, "{} columns", cols.len());
+        for (&c, &(lo, hi)) in &cols {
+            let (a, b) = (c as f64 * width, (c + 1) as f64 * width);
+            // A crest t = (1/4 + n)/f or a trough t = (3/4 + n)/f inside (a, b), clear of its
+            // ends (a boundary's rounding may put the point at it in the other column).
+            let inside = |phase: f64| {
+                let n = (a * f - phase + 1e-6).ceil();
+                (n + phase) / f < b - 1e-6
+            };
+            if inside(0.25) {
+                assert!(hi > 1.0 - 2e-4, "column {c}: {hi}");
+            }
+            if inside(0.75) {
+                assert!(lo < -1.0 + 2e-4, "column {c}: {lo}");
+            }
+        }
         assert!(pts.windows(2).all(|w| w[0].0 <= w[1].0));
         assert!(env.points(Trace::Eta(0)).is_none());
     }

@@ -1276,16 +1276,22 @@ impl<'a, E: Engine> Run<'a, E> {
 /// reaction (and latch moment, compliant latches), every base beam's root force and moment,
 /// the first six base modal coordinates — where the output rate is below
 /// [`super::envelope::ALIAS_FACTOR`] times the fastest vibration the run resolves: the
-/// base's highest kept mode, or a compliant latch's mode.
+/// base's highest kept mode, or the captured array's fastest mode on its latch springs. Only
+/// with the steppers that resolve that vibration at several points a period (the automatic
+/// one's scheduled steps, the explicit one's error-controlled steps): the adiabatic stepper
+/// carries its ringing inside long steps and the implicit one damps it, so neither has the
+/// points an envelope needs.
 fn envelope_of<E: Engine>(engine: &E, first: &Sample, s: &RunSettings) -> Option<Envelope> {
-    let latch = engine.latch_period();
-    let latch_omega = if latch > 0.0 {
-        2.0 * std::f64::consts::PI / latch
+    if !matches!(s.integrator, Integrator::Auto | Integrator::Explicit) {
+        return None;
+    }
+    let n = engine.hinges().len();
+    let latch_omega = if engine.compliant() {
+        engine.array_fastest(&vec![true; n], &vec![true; n])
     } else {
         0.0
     };
     let fastest = engine.base_resolved().max(latch_omega) / (2.0 * std::f64::consts::PI);
-    let n = engine.hinges().len();
     let mut traces: Vec<Trace> = (0..n).map(Trace::Rate).collect();
     traces.extend((0..n).map(Trace::Reaction));
     if engine.compliant() {

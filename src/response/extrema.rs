@@ -141,6 +141,7 @@ impl<'a> Bank<'a> {
 
     /// Every signal's (v(t), v′(t)) into `out` (one entry per signal).
     pub fn at(&self, t: f64, out: &mut [(f64, f64)]) {
+        debug_assert_eq!(out.len(), self.signals.len());
         for (o, s) in out.iter_mut().zip(&self.signals) {
             *o = (s.constant + s.slope * t, s.slope);
         }
@@ -568,7 +569,7 @@ impl Grid {
     /// segments that share their end knots: parts a search may walk side by side, fixed by
     /// the grid alone so that results do not depend on the number of threads.
     pub fn segments(&self, count: usize) -> Vec<(usize, usize)> {
-        let count = count.clamp(1, self.intervals);
+        let count = count.clamp(1, self.intervals.max(1));
         (0..count)
             .map(|i| (self.intervals * i / count, self.intervals * (i + 1) / count))
             .collect()

@@ -187,8 +187,9 @@ fn von_mises_rate(
 /// 1e-3 of a mode's amplitude).
 pub const REFINE_WINDOW: f64 = 5e-3;
 
-/// A section's peak stress at or below this fraction of the largest section's is rounding
-/// noise, reported as zero (the project's rule for every displayed quantity).
+/// A section's peak stress at or below this fraction of the largest section's — over every
+/// beam's stations searched together ([`beam_stresses`]) — is rounding noise, reported as
+/// zero at t = 0 (the project's rule for every displayed quantity).
 pub const NOISE: f64 = 1e-9;
 
 /// The peak of σ_vm at one section over the response.

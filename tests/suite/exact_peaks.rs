@@ -258,7 +258,6 @@ fn the_deployment_envelope_follows_the_ringing_the_samples_alias() {
         .iter()
         .any(|w| w.to_string().contains("deployment.output_rate")));
     let env = coarse.envelope.as_ref().expect("10 Hz aliases the latches");
-    let end = env.end_time;
     // Not the root force: right after the capture it carries the static correction's
     // quasi-static response, which the steps do not resolve and the 400 Hz samples read from
     // the steps' interpolant (docs/theory.md §2.9: root loads estimated, not bounded).
@@ -267,13 +266,14 @@ fn the_deployment_envelope_follows_the_ringing_the_samples_alias() {
         Trace::LatchMoment(0),
         Trace::LatchMoment(2),
         Trace::Rate(1),
-        // Base mode 1 bends the mast out of the deployment plane: zero by symmetry.
+        // Eta(0), base mode 1, bends the mast out of the deployment plane (zero by
+        // symmetry): base mode 2 instead.
         Trace::Eta(1),
     ];
     for trace in traces {
         let pts = env.points(trace).expect("kept");
         // Per column: the envelope's lowest and highest value.
-        let column = |t: f64| ((t / end * COLUMNS as f64) as usize).min(COLUMNS - 1);
+        let column = |t: f64| env.column(t);
         let mut cols = vec![(f64::INFINITY, f64::NEG_INFINITY); COLUMNS];
         for &(t, v) in &pts {
             let c = &mut cols[column(t)];
@@ -380,4 +380,37 @@ fn the_spectrum_is_what_a_least_squares_fit_of_the_history_finds() {
         checked += 1;
     }
     assert!(checked >= 5, "{checked}");
+}
+
+#[test]
+fn a_long_response_walked_in_segments_finds_the_one_walk_peaks() {
+    // 600 s of the seed's response: a grid of ~4.5e5 knots, walked in eight segments side by
+    // side whose searches are merged (`ModalResponse::on_grid_segments`). Each channel's
+    // peak must be the one a single walk of its own closed form finds (`extrema::peak`):
+    // both are values the signal attains within 1e-10 of its scale of the true maximum.
+    use flexcraft::response::extrema::grid;
+    let src = SEED.replace("duration = 60.0", "duration = 600.0");
+    assert_ne!(src, SEED);
+    let sim = Simulation::run(&scenario(&src)).expect("simulate");
+    let r = sim.response.as_ref().expect("response");
+    let signals = r.modal.signals(&sim.modes, &r.channels);
+    let duration = 600.0;
+    let fastest = signals.iter().map(WaveSum::fastest).fold(0.0, f64::max);
+    assert!(grid(fastest, duration).len() > 200_000);
+    let mut checked = 0;
+    for (c, ch) in r.channels.iter().enumerate() {
+        let scale = signals[c].scale(duration);
+        if scale == 0.0 || !(ch.name.contains("wing") || ch.name.contains("root")) {
+            continue;
+        }
+        let (one, _) = peak(&signals[c], duration);
+        let (segmented, _) = r.history.peak(c);
+        assert!(
+            (one - segmented).abs() <= 2e-10 * scale,
+            "{}: one walk {one} vs segments {segmented}",
+            ch.name
+        );
+        checked += 1;
+    }
+    assert!(checked >= 3, "{checked}");
 }
