@@ -339,9 +339,11 @@ impl<'a> SquaredNorm<'a> {
 
 impl Objective for SquaredNorm<'_> {
     fn at(&self, t: f64) -> (f64, f64) {
-        if let Some(bank) = &self.bank {
-            let mut out = vec![(0.0, 0.0); self.parts.len()];
-            bank.at(t, &mut out);
+        // A force's or a moment's three components on the stack (no allocation per point).
+        if let Some(bank) = self.bank.as_ref().filter(|_| self.parts.len() <= 3) {
+            let mut buf = [(0.0, 0.0); 3];
+            let out = &mut buf[..self.parts.len()];
+            bank.at(t, out);
             return out.iter().fold((0.0, 0.0), |(g, dg), (v, dv)| {
                 (g + v * v, dg + 2.0 * v * dv)
             });
