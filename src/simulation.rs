@@ -5,7 +5,7 @@
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{self, DeployError, DeploymentResult};
 use crate::response::channels::standard_channels;
-use crate::response::handover::hand_over_coupled;
+use crate::response::handover::{hand_over_coupled, line_damping_ratios};
 use crate::response::loads::{beam_root_channels, latch_channels};
 use crate::response::{Channel, Handover, ModalResponse, ResponseError, ResponseHistory};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
@@ -121,7 +121,8 @@ impl Simulation {
                     &handover.modal_displacement,
                     &handover.modal_velocity,
                     settings,
-                );
+                )
+                .with_line_damping(&line_damping_ratios(&model, &modes));
                 if let Some(req) = settings.modes {
                     if req > modal.available_elastic {
                         warnings.push(Warning::ModesClamped {
@@ -141,7 +142,8 @@ impl Simulation {
                 }
                 let mut channels = standard_channels(&model);
                 channels.extend(beam_root_channels(&model));
-                channels.extend(latch_channels(&model, &d.plate, &d.chain.hinges));
+                let lengths: Vec<f64> = d.chain.panels.iter().map(|p| p.length).collect();
+                channels.extend(latch_channels(&model, &d.plate, &d.chain.hinges, &lengths));
                 let history = modal.sample(&modes, &channels, settings);
                 warnings.extend(large_deflections(&model, &channels, &history));
                 let stresses = crate::response::stress::beam_stresses(

@@ -4,10 +4,12 @@
 //! assembly divides by the powers of L.
 
 pub mod characteristic;
+pub mod hinged;
 pub mod legendre;
 pub mod quadrature;
 
 pub use characteristic::{BeamFunctions, End, RodFunctions};
+pub use hinged::Hinged;
 pub use legendre::{LegendreBending, LegendreFree, LegendreRod};
 pub use quadrature::Quadrature;
 

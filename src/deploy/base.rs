@@ -328,7 +328,10 @@ impl Cloud {
         }
         for (i, p) in st.plates.iter().enumerate() {
             let id = ComponentId::Plate(i);
-            let (qx, qy) = (rule(p.terms.length), rule(p.terms.width));
+            let (qx, qy) = (
+                rule(p.terms.length).split(&p.hinge_positions()),
+                rule(p.terms.width),
+            );
             let origin = st.attachment_point(&p.attachment) - c_hub;
             for (&xi, &wx) in qx.points.iter().zip(&qx.weights) {
                 for (&eta, &wy) in qy.points.iter().zip(&qy.weights) {

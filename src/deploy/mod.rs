@@ -82,6 +82,11 @@ pub struct Deployment {
     /// (`[deployment] base_damping_ratio`; 0, undamped, by default). A physical option, not
     /// a numerical one: it changes the results.
     pub base_damping_ratio: f64,
+    /// With compliant latches, how the run goes on after the last capture, overriding the
+    /// latch model's (`settle_time`, else one latch period and the hand-over): e.g.
+    /// [`Settle::decayed`], to run until the latches' motion has decayed. `None` from a
+    /// scenario file.
+    pub settling: Option<Settle>,
 }
 
 /// The time integrator of a deployment run.
@@ -116,8 +121,9 @@ pub enum LatchModel {
         stiffness: Vec<f64>,
         /// Per hinge, N·m·s/rad.
         damping: Vec<f64>,
-        /// How long the run continues after the last capture, s (`None`: until the latches'
-        /// motion has decayed, [`Settle::decayed`]).
+        /// How long the run continues after the last capture, s (`None`: one latch period,
+        /// then the hand-over to the deployed model, which carries the latch springs,
+        /// [`Settle::hand_over`]).
         settle_time: Option<f64>,
     },
 }
@@ -138,6 +144,14 @@ pub use timescales::latch_period;
 pub enum Settle {
     /// For this long, s (`[deployment.latch] settle_time`).
     For(f64),
+    /// The default: for `window` s (one [`latch_period`]) after the last capture, which holds
+    /// the last-captured hinge's first latch-moment peak, then the hand-over: the deployed
+    /// model carries the latch springs (docs/theory.md §1.6), so the latched array's ringing
+    /// goes on there, exactly, in the response.
+    HandOver {
+        /// The time after the last capture, s.
+        window: f64,
+    },
     /// Until the latches' motion has decayed (the default): the run ends once no captured
     /// hinge's rate has exceeded [`SETTLE_TOLERANCE`] times the largest hinge rate at a
     /// capture for one `window` (s), and at the latest `cap` s after the last capture (a
@@ -161,11 +175,19 @@ impl Settle {
         }
     }
 
+    /// The default: [`Settle::HandOver`] after one [`latch_period`] of the captured array.
+    pub fn hand_over(chain: &Chain, stiffness: &[f64], sync: Synchronisation) -> Self {
+        Self::HandOver {
+            window: latch_period(chain, stiffness, sync),
+        }
+    }
+
     /// The longest the run goes on after the last capture, s.
     pub fn limit(&self) -> f64 {
         match *self {
             Self::For(d) => d,
             Self::Decayed { cap, .. } => cap,
+            Self::HandOver { window } => window,
         }
     }
 }
@@ -175,6 +197,9 @@ impl Settle {
 pub enum Settled {
     /// After the `settle_time` asked for.
     AfterTime,
+    /// One latch period after the last capture, handed over to the deployed model with its
+    /// latch springs ([`Settle::HandOver`], the default).
+    HandedOver,
     /// The latches' motion decayed below [`SETTLE_TOLERANCE`] (for one window).
     Decayed,
     /// At the cap, with the motion not decayed: the largest captured-hinge rate in the last
@@ -588,6 +613,85 @@ fn truncation_check(
 }
 
 impl Deployment {
+    /// The compliant latches as hinge lines of the deployed wing (docs/theory.md §1.6): hinge
+    /// i's line at the sum of the panel lengths inboard of it (hinge 1 at the root edge),
+    /// with its latch spring and dashpot in parallel with the hinge's own spring and damper
+    /// (which keep acting once latched, as in the run; its friction is left out). Empty with rigid latches (the latched wing is one
+    /// plate).
+    pub fn latch_lines(&self) -> Vec<crate::structure::LineHinge> {
+        let LatchModel::Compliant {
+            stiffness, damping, ..
+        } = &self.latch
+        else {
+            return Vec::new();
+        };
+        let mut at = 0.0;
+        self.chain
+            .panels
+            .iter()
+            .zip(&self.chain.hinges)
+            .zip(stiffness.iter().zip(damping))
+            .map(|((p, h), (&k, &c))| {
+                let line = crate::structure::LineHinge {
+                    at,
+                    stiffness: k + h.stiffness,
+                    damping: c + h.damping,
+                };
+                at += p.length;
+                line
+            })
+            .collect()
+    }
+
+    /// `st` with the deploying plate cut along [`Deployment::latch_lines`]: the deployed
+    /// spacecraft whose wing stands on its compliant latches (`st` unchanged with rigid ones).
+    pub fn latched_structure(
+        &self,
+        st: &Structure,
+    ) -> Result<Structure, crate::structure::StructureError> {
+        let lines = self.latch_lines();
+        let mut st = st.clone();
+        if lines.is_empty() {
+            return Ok(st);
+        }
+        let n = lines.len();
+        let Some(p) = st.plates.iter_mut().find(|p| p.name == self.plate) else {
+            return Ok(st);
+        };
+        let hinged = p.clone().with_hinges(lines)?;
+        // The cable ties the latched hinges as it tied the opening ones, in the lines'
+        // rotations θ_j = d_j δα_j: an ideal cable leaves one motion, δα = r s with
+        // r = (1, 2, 2, …) (one kink function Σ_j d_j r_j K_j); an elastic one adds
+        // k_c (C D)ᵀ(C D) between the lines (C the cable law's rows, D = diag(d_j)).
+        *p = match self.synchronisation {
+            Synchronisation::None => hinged,
+            Synchronisation::IdealCable => hinged.with_tied_hinges(
+                vec![(0..n)
+                    .map(|j| Chain::d(j) * if j == 0 { 1.0 } else { 2.0 })
+                    .collect()],
+                Vec::new(),
+            )?,
+            Synchronisation::ElasticCable(kc) => {
+                let rows = Coupled::cable_law(n);
+                let coupling = (0..n)
+                    .map(|j| {
+                        (0..n)
+                            .map(|l| {
+                                let c: f64 = rows.iter().map(|r| r[j] * r[l]).sum();
+                                kc * c * Chain::d(j) * Chain::d(l)
+                            })
+                            .collect()
+                    })
+                    .collect();
+                let identity = (0..n)
+                    .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+                    .collect();
+                hinged.with_tied_hinges(identity, coupling)?
+            }
+        };
+        Ok(st)
+    }
+
     /// The run settings.
     pub fn settings(&self) -> RunSettings {
         RunSettings {
@@ -602,10 +706,12 @@ impl Deployment {
                     stiffness,
                     settle_time,
                     ..
-                } => Some(settle_time.map_or_else(
-                    || Settle::decayed(&self.chain, stiffness, self.synchronisation),
-                    Settle::For,
-                )),
+                } => Some(self.settling.unwrap_or_else(|| {
+                    settle_time.map_or_else(
+                        || Settle::hand_over(&self.chain, stiffness, self.synchronisation),
+                        Settle::For,
+                    )
+                })),
             },
             record_samples: true,
             schedule: run::Schedule::default(),

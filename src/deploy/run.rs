@@ -736,7 +736,7 @@ impl<'a, E: Engine> Run<'a, E> {
         };
         let last_time = last.time;
         let (ratio, decayed) = match settle {
-            Settle::For(_) => (None, false),
+            Settle::For(_) | Settle::HandOver { .. } => (None, false),
             Settle::Decayed { window, .. } => {
                 let r = self.rates_left(step, window);
                 (
@@ -748,7 +748,11 @@ impl<'a, E: Engine> Run<'a, E> {
         self.settled = if decayed {
             Some(Settled::Decayed)
         } else if self.t >= last_time + settle.limit() {
-            Some(ratio.map_or(Settled::AfterTime, |ratio| Settled::Capped { ratio }))
+            Some(match (settle, ratio) {
+                (Settle::HandOver { .. }, _) => Settled::HandedOver,
+                (_, Some(ratio)) => Settled::Capped { ratio },
+                (_, None) => Settled::AfterTime,
+            })
         } else if self.t >= self.s.end_time {
             Some(Settled::EndTime { ratio })
         } else {

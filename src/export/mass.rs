@@ -44,7 +44,7 @@ pub fn element_count(st: &crate::structure::Structure) -> u64 {
             .sum::<u64>()
         + st.plates
             .iter()
-            .map(|p| points(p.terms.length) * points(p.terms.width))
+            .map(|p| points(p.terms.length) * (p.hinges.len() as u64 + 1) * points(p.terms.width))
             .sum::<u64>()
 }
 
@@ -133,7 +133,7 @@ pub fn mass_elements(model: &RitzModel, shapes: &[&[f64]]) -> Vec<MassElement> {
         }
     }
     for (i, p) in st.plates.iter().enumerate() {
-        let rx = rule_for(p.terms.length);
+        let rx = rule_for(p.terms.length).split(&p.hinge_positions());
         let ry = rule_for(p.terms.width);
         let area = p.length * p.width;
         let att = attachments(ComponentId::Plate(i));

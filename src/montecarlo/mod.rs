@@ -15,7 +15,7 @@ pub mod stats;
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{simulate_coupled_with, Deployment, DeploymentResult, LatchModel};
 use crate::response::channels::standard_channels;
-use crate::response::handover::hand_over_coupled;
+use crate::response::handover::{hand_over_coupled, line_damping_ratios};
 use crate::response::{Channel, ModalResponse, ResponseError};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
 use crate::scenario::{DeploymentOverrides, OverrideValue, Scenario};
@@ -382,10 +382,16 @@ impl ResponseModel {
     /// The model, modes and deflection channels of a scenario's structure, as `simulate`
     /// computes them.
     fn new(s: &Scenario) -> Result<Self, RitzError> {
-        let model = RitzModel::assemble(&s.structure);
+        Self::of(&s.structure, s)
+    }
+
+    /// As [`ResponseModel::new`] for the structure `st` (the scenario's, its wing on a
+    /// sampled deployment's latch lines).
+    fn of(st: &crate::structure::Structure, s: &Scenario) -> Result<Self, RitzError> {
+        let model = RitzModel::assemble(st);
         let modes = ModalAnalysis::compute(&model)?.with_selection(s.term_selection.as_ref());
         let all = standard_channels(&model);
-        let channels = deflection_channels(&s.structure)
+        let channels = deflection_channels(st)
             .into_iter()
             .map(|(_, c)| {
                 (all.iter().find(|a| a.name == c).cloned())
@@ -422,7 +428,8 @@ impl ResponseModel {
             &h.modal_displacement,
             &h.modal_velocity,
             settings,
-        );
+        )
+        .with_line_damping(&line_damping_ratios(&self.model, &self.modes));
         let history = modal.sample(&self.modes, &self.channels, settings);
         Ok((0..self.channels.len())
             .map(|k| history.peak(k).0)
@@ -504,15 +511,19 @@ impl<'a> Runner<'a> {
         };
         let mut out = outputs(&s.structure, &d, &c, &r);
         if let Some(base_model) = &self.response {
-            let same = std::ptr::eq(s, self.base)
-                || (s.structure == self.base.structure
-                    && s.term_selection.is_none()
-                    && self.base.term_selection.is_none());
+            // The deployed wing stands on this run's latch lines (a sampled latch or hinge
+            // spring changes the deployed modes).
+            let Ok(deployed) = d.latched_structure(&s.structure) else {
+                return empty(RunStatus::Refused);
+            };
+            let same = deployed == self.base.structure
+                && (std::ptr::eq(s, self.base)
+                    || (s.term_selection.is_none() && self.base.term_selection.is_none()));
             let own;
             let model = if same {
                 base_model.as_ref().ok()
             } else {
-                own = ResponseModel::new(s);
+                own = ResponseModel::of(&deployed, s);
                 own.as_ref().ok()
             };
             let Some(peaks) = model.and_then(|m| m.peaks(s, &d, &c, &r).ok()) else {

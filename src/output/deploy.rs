@@ -576,6 +576,11 @@ fn settled_text(s: Option<Settled>) -> String {
     let tol = 100.0 * SETTLE_TOLERANCE;
     match s {
         Some(Settled::AfterTime) => "the settle_time asked for".to_string(),
+        Some(Settled::HandedOver) => {
+            "one latch period after the last capture (the deployed model, \
+             which carries the latch springs, takes the latched array's motion over)"
+                .to_string()
+        }
         Some(Settled::Decayed) => format!(
             "the latches settled (every captured hinge's rate below {tol} % of the largest at a \
              capture for one latch period)"
@@ -596,6 +601,7 @@ fn settled_text(s: Option<Settled>) -> String {
 fn settled_json(s: Option<Settled>) -> Value {
     match s {
         Some(Settled::AfterTime) => json!({"by": "settle_time"}),
+        Some(Settled::HandedOver) => json!({"by": "hand_over"}),
         Some(Settled::Decayed) => json!({"by": "decayed", "tolerance": SETTLE_TOLERANCE}),
         Some(Settled::Capped { ratio }) => {
             json!({"by": "cap", "tolerance": SETTLE_TOLERANCE, "ratio": ratio})

@@ -53,6 +53,7 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             "elastic_energy_after": h.elastic_energy_after,
             "projection_residual": (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
             "latch_energy": h.latch_energy,
+            "latch_energy_carried": h.latch_carried,
         },
         "response": {
             "duration": st.duration,
@@ -300,13 +301,20 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
         lost,
         100.0 * lost / h.energy_before.max(1e-300)
     );
+    // With the latch lines in the deployed model its elastic energy holds the latch springs'.
+    let carried = if h.latch_carried { h.latch_energy } else { 0.0 };
     let (before, after) = (
-        h.energy_before + h.elastic_energy_before,
+        h.energy_before + h.elastic_energy_before + carried,
         h.energy_after + h.elastic_energy_after,
     );
+    let springs = if h.latch_carried {
+        format!(" (base) + {:.6e} J (latch springs)", h.latch_energy)
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         o,
-        "  elastic energy before {:.6e} J, after {:.6e} J; total {:.6e} J → {:.6e} J: projection residual {:.6e} J ({:.4} %)",
+        "  elastic energy before {:.6e} J{springs}, after {:.6e} J; total {:.6e} J → {:.6e} J: projection residual {:.6e} J ({:.4} %)",
         h.elastic_energy_before,
         h.elastic_energy_after,
         before,
@@ -314,7 +322,7 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
         before - after,
         100.0 * (before - after) / before.max(1e-300)
     );
-    if h.latch_energy > 0.0 {
+    if h.latch_energy > 0.0 && !h.latch_carried {
         let _ = writeln!(
             o,
             "  latch springs' energy {:.6e} J ({:.2e} of the kinetic + elastic energy handed over): not carried, the deployed wing has no latch spring",
@@ -384,13 +392,23 @@ fn noise_floor<'a>(s: &Scenario, r: &'a Response) -> impl Fn(f64, &str) -> f64 +
 /// The response's lines of the terminal summary.
 fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) {
     let st = &s.response;
+    // The latch lines' dashpots damp the modes that move them (docs/theory.md §1.6).
+    let lines_damp = r
+        .modal
+        .modes
+        .iter()
+        .any(|m| !m.rigid && m.zeta > st.damping_ratio);
+    let zeta_text = if lines_damp {
+        format!("ζ = {} plus the latch dashpots' per mode", st.damping_ratio)
+    } else {
+        format!("ζ = {}", st.damping_ratio)
+    };
     let _ = writeln!(
         o,
-        "\nResponse over {} s after the hand-over ({} samples at {} Hz, ζ = {}):",
+        "\nResponse over {} s after the hand-over ({} samples at {} Hz, {zeta_text}):",
         st.duration,
         r.history.times.len(),
         st.output_rate,
-        st.damping_ratio
     );
     let snap = noise_floor(s, r);
     for (c, ch) in r.channels.iter().enumerate() {
@@ -477,7 +495,7 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
         rw[1],
         rw[2]
     );
-    if st.damping_ratio == 0.0 {
+    if !lines_damp && st.damping_ratio == 0.0 {
         let _ = writeln!(
             o,
             "  elastic energy drift over the run: {:.2e} (relative; undamped, so rounding only)",
@@ -487,10 +505,9 @@ fn response_lines(o: &mut String, s: &Scenario, sim: &Simulation, r: &Response) 
         let e = &r.history.elastic_energy;
         let _ = writeln!(
             o,
-            "  elastic energy at the end: {:.4} % of the hand-over's (modal damping ζ = {})",
+            "  elastic energy at the end: {:.4} % of the hand-over's (modal damping {zeta_text})",
             100.0 * e.last().copied().unwrap_or(0.0)
                 / e.first().copied().unwrap_or(1.0).max(1e-300),
-            st.damping_ratio
         );
     }
 }
@@ -559,6 +576,7 @@ pub(crate) fn handover_instant(h: &crate::response::handover::Handover) -> Strin
         None => return format!("latch of hinge {}", h.latch_hinge),
         Some(Settled::Decayed) => "after the latches settled",
         Some(Settled::AfterTime) => "after the settle_time",
+        Some(Settled::HandedOver) => "one latch period after the last capture",
         Some(Settled::Capped { .. }) => "at the settling's cap, the latches NOT settled",
         Some(Settled::EndTime { .. }) => "at end_time, the latches NOT settled",
     };

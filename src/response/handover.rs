@@ -38,6 +38,7 @@ use crate::math::Vec3;
 use crate::ritz::assembly::{Element, ElementKind, FieldKind, HUB_DOF};
 use crate::ritz::{ModalAnalysis, RitzModel};
 use crate::structure::{ComponentId, HubMotion, Plate, RigidBody, Structure};
+use faer::linalg::solvers::Solve;
 
 /// How the deployment's motion becomes the structure's initial velocity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -101,7 +102,9 @@ pub struct Handover {
     /// Momentum after, rows of M q̇⁺ (a free hub's; for a fixed hub the supports take it).
     pub momentum_after: Momentum,
     /// Largest |α_i − latch angle_i| at the final latch, rad (non-zero only with
-    /// simultaneous latching: the hand-over still uses the straight wing).
+    /// simultaneous latching: the hand-over still uses the straight wing); with the latch
+    /// lines in the deployed model ([`Handover::latch_carried`]) only the part they cannot
+    /// take (off the ideal cable's manifold).
     pub angle_mismatch: f64,
     /// Hub position u, v (m) and rotation θ (rad) in the deployment plane at the latch
     /// (planar chain; zero for the coupled model, whose hub pose is in the deployment's
@@ -115,10 +118,13 @@ pub struct Handover {
     /// Elastic energy of the initial displacement in the deployed model, ½Σ ω_j² η_j(0)², J.
     pub elastic_energy_after: f64,
     /// Compliant latches: their springs' energy at the hand-over, ½ Σ k_L,j (α_j − α_j^L)², J.
-    /// The deployed wing has no latch spring and starts straight (the panels' small angles
-    /// off the latch angles are dropped, [`Handover::angle_mismatch`]), so the response does
-    /// not carry it.
+    /// With [`Handover::latch_carried`] the deployed wing's hinge lines take the hinges'
+    /// angles off their equilibrium as its initial displacement, so the response carries it
+    /// (in `elastic_energy_after`).
     pub latch_energy: f64,
+    /// The deployed model carries the latch springs (its wing is cut along hinge lines,
+    /// docs/theory.md §1.6): the latched array's motion goes on in the response.
+    pub latch_carried: bool,
     /// Notes on choices the data forced (printed as warnings).
     pub notes: Vec<String>,
 }
@@ -365,6 +371,24 @@ pub fn modal_velocities(modal: &ModalAnalysis, b: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Every mode's damping ratio from the hinge lines' dashpots, φ_jᵀ C φ_j / (2ω_j)
+/// ([`RitzModel::line_damping`]; zero for rigid modes and without hinge lines), for
+/// [`super::ModalResponse::with_line_damping`].
+pub fn line_damping_ratios(model: &RitzModel, modal: &ModalAnalysis) -> Vec<f64> {
+    let c = model.line_damping();
+    modal
+        .modes
+        .iter()
+        .map(|m| {
+            if m.rigid || m.omega_rad_s <= 0.0 || c.is_empty() {
+                return 0.0;
+            }
+            let q: f64 = c.iter().map(|&(i, j, v)| m.shape[i] * v * m.shape[j]).sum();
+            q / (2.0 * m.omega_rad_s)
+        })
+        .collect()
+}
+
 /// The final latch of a run in which every hinge latched.
 fn final_latch(result: &DeploymentResult) -> Result<&LatchEvent, ResponseError> {
     match result.latches.last() {
@@ -431,6 +455,7 @@ pub fn hand_over(
         elastic_energy_before: 0.0,
         elastic_energy_after: 0.0,
         latch_energy: 0.0,
+        latch_carried: false,
         notes,
     })
 }
@@ -471,6 +496,85 @@ fn base_state(coupled: &Coupled, model: &RitzModel, y: &[f64]) -> (Vec<f64>, Vec
         }
     }
     (velocity, q0)
+}
+
+/// The deployed wing's hinge lines (docs/theory.md §1.6) take the captured hinges' angles
+/// off their equilibrium as kinks: hinge j at α_j turns its outboard side by
+/// θ_j = d_j (α_j − α_j^eq) about ẑ = e_a × n (d_j = ∓1 the chain's sign of α_j in the panel
+/// angles), α_j^eq = (k_j α_j^ref + k_L,j α_j^L)/(k_j + k_L,j) the angle at which the latch
+/// spring holds the hinge spring's preload (the straight deployed wing is the model's
+/// equilibrium). The kink functions F_i = Σ_j W_ij K_j take the rotations that fit them in
+/// least squares weighted by the lines' stiffness (exact for independent lines, W = I, and
+/// for a state on an ideal cable's manifold), less the fit of the equilibrium's offsets, and
+/// their coordinates h_in (W = Σ F_i(x/a) h_in Y_n) the uniform
+/// rotation: h_in = a s_i c_n with Σ c_n Y_n = 1 (the width family holds the constant: its
+/// rigid pair). Nothing without hinge lines (rigid latches).
+///
+/// Returns the largest |θ_j − Σ_i W_ij s_i| of the angles off the latch angles (rad): what
+/// the lines cannot take (a state off an ideal cable's manifold; zero for independent
+/// lines), or `None` without lines.
+fn latch_displacement(
+    coupled: &Coupled,
+    y: &[f64],
+    view: &PlateView<'_>,
+    q0: &mut [f64],
+) -> Option<f64> {
+    let lines = view.plate.hinges();
+    let w = view.plate.hinge_functions();
+    let latch = coupled.latch.as_ref()?;
+    if lines.is_empty() || w.is_empty() {
+        return None;
+    }
+    let iy = crate::basis::Integrals::new(view.yb);
+    let ny = view.yb.len();
+    let c = constant_coefficients(&iy);
+    let smooth = view.xb.len() - w.len();
+    let start = view.element.own_range().start;
+    let sv = coupled.view(y);
+    let ev = coupled.evaluate(y);
+    let z_plate = view.plate.length_axis.cross(view.plate.normal);
+    let sense = ev.frame.apply(Vec3::new(0.0, 0.0, 1.0)).dot(z_plate);
+    // θ_j off the latch angle, and the equilibrium's own offset from it.
+    let (mut theta, mut offset) = (Vec::new(), Vec::new());
+    for (j, h) in coupled.chain.hinges.iter().enumerate().take(lines.len()) {
+        let (k, kl) = (h.stiffness, latch.stiffness[j]);
+        let eq = (k * h.reference_angle + kl * h.latch_angle) / (k + kl);
+        theta.push(Chain::d(j) * (sv.alpha[j] - h.latch_angle) * sense);
+        offset.push(Chain::d(j) * (eq - h.latch_angle) * sense);
+    }
+    // The lines' stiffness-weighted fit (W K Wᵀ) s = W K θ: on an ideal cable's manifold the
+    // fit of the offsets is the tied array's own equilibrium, the minimum of Σ ½ K_j (θ_j −
+    // offset_j)² over its one motion.
+    let nf = w.len();
+    let kw: Vec<f64> = lines.iter().map(|l| l.stiffness).collect();
+    let wdot = |a: &[f64], b: &[f64]| (0..a.len()).map(|j| a[j] * kw[j] * b[j]).sum::<f64>();
+    let gram = faer::Mat::<f64>::from_fn(nf, nf, |i, k| wdot(&w[i], &w[k]));
+    let lu = gram.as_ref().partial_piv_lu();
+    let fit = |v: &[f64]| {
+        let rhs = faer::Mat::<f64>::from_fn(nf, 1, |i, _| wdot(&w[i], v));
+        let s = lu.solve(&rhs);
+        (0..nf).map(|i| s[(i, 0)]).collect::<Vec<f64>>()
+    };
+    let (s_state, s_eq) = (fit(&theta), fit(&offset));
+    for i in 0..nf {
+        for (n, cn) in c.iter().enumerate() {
+            q0[start + (smooth + i) * ny + n] += view.plate.length * (s_state[i] - s_eq[i]) * cn;
+        }
+    }
+    Some(
+        (0..lines.len())
+            .map(|j| (theta[j] - (0..nf).map(|i| w[i][j] * s_state[i]).sum::<f64>()).abs())
+            .fold(0.0, f64::max),
+    )
+}
+
+/// The coefficients c of the constant function in a family: ∫Y_m Y_n c_n = ∫Y_m (the
+/// least-squares fit, exact when the family holds the constant).
+fn constant_coefficients(iy: &crate::basis::Integrals) -> Vec<f64> {
+    let n = iy.m0.len();
+    let rhs = faer::Mat::<f64>::from_fn(n, 1, |i, _| iy.m0[i]);
+    let sol = iy.i00.as_ref().partial_piv_lu().solve(&rhs);
+    (0..n).map(|i| sol[(i, 0)]).collect()
 }
 
 /// The coupled state as the hand-over's pre-latch motion: the hub's velocity, the base's
@@ -540,7 +644,9 @@ pub fn hand_over_coupled(
     let view = PlateView::find(model, &deployment.plate)?;
     let n = model.dof();
     let y = result.final_state();
-    let (base_velocity, q0) = base_state(coupled, model, &y);
+    let (base_velocity, mut q0) = base_state(coupled, model, &y);
+    let residual = latch_displacement(coupled, &y, &view, &mut q0);
+    let carried = residual.is_some();
     let pl = coupled_pre_latch(coupled, &y, view.plate.length_axis, base_velocity);
     let mut notes = Vec::new();
     let energy_before = coupled.kinetic_energy(&y);
@@ -588,13 +694,15 @@ pub fn hand_over_coupled(
         .map(|(md, e)| 0.5 * md.omega_rad_s.powi(2) * e * e)
         .sum();
     let off = coupled.alpha_offset();
-    let angle_mismatch = coupled
-        .chain
-        .hinges
-        .iter()
-        .enumerate()
-        .map(|(i, h)| (result.final_q[off + i] - h.latch_angle).abs())
-        .fold(0.0, f64::max);
+    let angle_mismatch = residual.unwrap_or_else(|| {
+        coupled
+            .chain
+            .hinges
+            .iter()
+            .enumerate()
+            .map(|(i, h)| (result.final_q[off + i] - h.latch_angle).abs())
+            .fold(0.0, f64::max)
+    });
     if (energy_before_field - energy_before).abs() > 1e-6 * energy_before.abs().max(1e-300)
         && method == HandoverMethod::Projection
     {
@@ -624,6 +732,7 @@ pub fn hand_over_coupled(
         elastic_energy_before: coupled.elastic_energy(&y),
         elastic_energy_after,
         latch_energy: coupled.latch_energy(&y, &vec![true; coupled.panels()]),
+        latch_carried: carried,
         notes,
     })
 }

@@ -77,7 +77,12 @@ pub fn beam_root_channels(model: &RitzModel) -> Vec<Channel> {
 /// The latch moments `latch_moment_<k>` (N·m, on the hinge coordinate α_k) of the deployed
 /// wing `plate`, one per hinge of `hinges` (module doc). Empty if the plate is not in the
 /// model.
-pub fn latch_channels(model: &RitzModel, plate: &str, hinges: &[Hinge]) -> Vec<Channel> {
+pub fn latch_channels(
+    model: &RitzModel,
+    plate: &str,
+    hinges: &[Hinge],
+    panel_lengths: &[f64],
+) -> Vec<Channel> {
     let st = &model.structure;
     let Some(pi) = st.plates.iter().position(|p| p.name == plate) else {
         return Vec::new();
@@ -90,8 +95,18 @@ pub fn latch_channels(model: &RitzModel, plate: &str, hinges: &[Hinge]) -> Vec<C
     };
     let p = &st.plates[pi];
     let (a, b, mu) = (p.length, p.width, p.areal_density);
-    let n_panels = hinges.len().max(1);
-    let y_means = means(width.as_ref(), 0.0, |_| 1.0);
+    // Hinge k's line at the panels' lengths inboard of it (the deployment's panels, equal or
+    // not); the length family's kinks (latch lines) break the quadrature there.
+    let lines: Vec<f64> = panel_lengths
+        .iter()
+        .scan(0.0, |at, l| {
+            let x = *at;
+            *at += l;
+            Some(x)
+        })
+        .collect();
+    let breaks = p.hinge_positions();
+    let y_means = means(width.as_ref(), 0.0, |_| 1.0, &[]);
     let own = e.own_range().start;
     let ny = width.len();
     hinges
@@ -99,12 +114,12 @@ pub fn latch_channels(model: &RitzModel, plate: &str, hinges: &[Hinge]) -> Vec<C
         .enumerate()
         .map(|(i, h)| {
             let k = i + 1;
-            let xk = a * i as f64 / n_panels as f64;
+            let xk = lines.get(i).copied().unwrap_or(0.0);
             let a1 = 0.5 * (a - xk).powi(2);
             let a2 = a.powi(3) / 3.0 - xk * a * a / 2.0 + xk.powi(3) / 6.0;
             let coef_u = p.normal * (-mu * b * a1);
             let coef_th = p.width_axis() * (mu * b * a2);
-            let x_moments = means(length.as_ref(), xk / a, |xi| a * xi - xk);
+            let x_moments = means(length.as_ref(), xk / a, |xi| a * xi - xk, &breaks);
             let sign = if k % 2 == 1 { 1.0 } else { -1.0 };
             let t = &e.attachment;
             let mut row: Vec<f64> = (0..model.dof())
@@ -133,19 +148,30 @@ pub fn latch_channels(model: &RitzModel, plate: &str, hinges: &[Hinge]) -> Vec<C
 }
 
 /// ∫_{ξ₀}^1 w(ξ) F_m(ξ) dξ for every function F_m of a family, by Gauss–Legendre quadrature on
-/// [ξ₀, 1] (exact for the polynomial families with w linear).
-fn means(basis: &dyn Basis1d, xi0: f64, weight: impl Fn(f64) -> f64) -> Vec<f64> {
+/// each piece of [ξ₀, 1] between the `breaks` (the kinks of a plate's latch lines; exact for
+/// the polynomial families with w linear).
+fn means(basis: &dyn Basis1d, xi0: f64, weight: impl Fn(f64) -> f64, breaks: &[f64]) -> Vec<f64> {
     let q = Quadrature::gauss(basis.len() + 24);
-    let span = 1.0 - xi0;
+    let mut ends: Vec<f64> = breaks
+        .iter()
+        .copied()
+        .filter(|&b| b > xi0 && b < 1.0)
+        .collect();
+    ends.push(1.0);
     let mut out = vec![0.0; basis.len()];
     let mut vals = vec![[0.0; 4]; basis.len()];
-    for (&t, &w) in q.points.iter().zip(&q.weights) {
-        let xi = xi0 + span * t;
-        basis.eval_all(xi, &mut vals);
-        let f = w * span * weight(xi);
-        for (o, v) in out.iter_mut().zip(&vals) {
-            *o += f * v[0];
+    let mut lo = xi0;
+    for hi in ends {
+        let span = hi - lo;
+        for (&t, &w) in q.points.iter().zip(&q.weights) {
+            let xi = lo + span * t;
+            basis.eval_all(xi, &mut vals);
+            let f = w * span * weight(xi);
+            for (o, v) in out.iter_mut().zip(&vals) {
+                *o += f * v[0];
+            }
         }
+        lo = hi;
     }
     out
 }

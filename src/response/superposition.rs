@@ -29,6 +29,9 @@ pub struct KeptMode {
     pub eta0: f64,
     /// η̇(0).
     pub eta_dot0: f64,
+    /// ζ: `[response] damping_ratio` plus the hinge lines' dashpots
+    /// ([`ModalResponse::with_line_damping`]); unused for rigid modes.
+    pub zeta: f64,
 }
 
 /// The modal model of the response.
@@ -45,6 +48,9 @@ pub struct ModalResponse {
     /// Fraction of the hand-over kinetic energy carried by the kept modes.
     pub captured_energy_fraction: f64,
 }
+
+/// The largest modal damping ratio the response's underdamped closed form takes.
+pub const MAX_ZETA: f64 = 0.95;
 
 /// Sampled response.
 #[derive(Debug, Clone)]
@@ -106,6 +112,7 @@ impl ModalResponse {
                     omega_rad_s: m.omega_rad_s,
                     eta0: e,
                     eta_dot0: v,
+                    zeta: settings.damping_ratio,
                 });
             }
         }
@@ -118,6 +125,18 @@ impl ModalResponse {
         }
     }
 
+    /// Adds to every kept elastic mode's ζ the hinge lines' dashpots (docs/theory.md §1.6):
+    /// `extra[number − 1]` = φ_jᵀ C φ_j / (2ω_j), the diagonal of the damping in modal
+    /// coordinates (the off-diagonal terms, second order for light damping, are left out). The
+    /// sum stays below [`MAX_ZETA`] (the closed form is the underdamped one).
+    pub fn with_line_damping(mut self, extra: &[f64]) -> Self {
+        for m in self.modes.iter_mut().filter(|m| !m.rigid) {
+            let add = extra.get(m.number - 1).copied().unwrap_or(0.0);
+            m.zeta = (m.zeta + add).min(MAX_ZETA);
+        }
+        self
+    }
+
     /// Number of elastic modes kept.
     pub fn kept_elastic(&self) -> usize {
         self.modes.iter().filter(|m| !m.rigid).count()
@@ -125,7 +144,7 @@ impl ModalResponse {
 
     /// (η, η̇) of kept mode j at time t.
     pub fn state(&self, j: usize, t: f64) -> (f64, f64) {
-        state(&self.modes[j], self.damping_ratio, t)
+        state(&self.modes[j], t)
     }
 
     /// Samples the response at t_k = k/rate, k = 0…rows−1, into the given channels.
@@ -151,7 +170,7 @@ impl ModalResponse {
                 .try_as_col_major_mut()
                 .expect("a fresh Mat is column-major")
                 .as_slice_mut();
-            fill_mode(m, self.damping_ratio, h, col, &mut acc, &mut energy);
+            fill_mode(m, h, col, &mut acc, &mut energy);
             for (k, a) in acc.iter().enumerate() {
                 eta_dd[(k, j)] = *a;
             }
@@ -207,7 +226,7 @@ impl ModalResponse {
                 waves: Vec::new(),
             };
         }
-        let (w, z) = (m.omega_rad_s, self.damping_ratio);
+        let (w, z) = (m.omega_rad_s, m.zeta);
         let wd = w * (1.0 - z * z).sqrt();
         WaveSum {
             constant: 0.0,
@@ -342,7 +361,6 @@ impl ModalResponse {
         let (id, gd) = order_of(Order::Displacement);
         let (ia, ga) = order_of(Order::Acceleration);
         let nm = self.modes.len();
-        let zeta = self.damping_ratio;
         let h = grid.spacing();
         let chunk = PEAK_CHUNK.min(range.1 - range.0 + 1);
         let (mut e, mut ed, mut edd, mut eddd) = (
@@ -360,7 +378,11 @@ impl ModalResponse {
             times.extend((start..=end).map(|k| grid.at(k)));
             // η, η̇, η̈ = −2ζωη̇ − ω²η and η⃛ = −2ζωη̈ − ω²η̇ of every mode at the piece's times.
             for (j, m) in self.modes.iter().enumerate() {
-                let w = if m.rigid { 0.0 } else { m.omega_rad_s };
+                let (w, zeta) = if m.rigid {
+                    (0.0, 0.0)
+                } else {
+                    (m.omega_rad_s, m.zeta)
+                };
                 let (x, xd) = (
                     e.col_mut(j)
                         .try_as_col_major_mut()
@@ -371,7 +393,7 @@ impl ModalResponse {
                         .expect("a fresh Mat is column-major")
                         .as_slice_mut(),
                 );
-                fill_state(m, zeta, grid.at(start), h, &mut x[..rows], &mut xd[..rows]);
+                fill_state(m, grid.at(start), h, &mut x[..rows], &mut xd[..rows]);
                 for i in 0..rows {
                     let (x, xd) = (e[(i, j)], ed[(i, j)]);
                     let xdd = -2.0 * zeta * w * xd - w * w * x;
@@ -590,21 +612,14 @@ const PEAK_CHUNK: usize = 2048;
 
 /// Samples at t_k = k·h of one mode into `eta` and its acceleration
 /// η̈ = −2ζωη̇ − ω²η into `eta_dd`, adding its energy to `energy` (elastic modes).
-fn fill_mode(
-    m: &KeptMode,
-    zeta: f64,
-    h: f64,
-    eta: &mut [f64],
-    eta_dd: &mut [f64],
-    energy: &mut [f64],
-) {
+fn fill_mode(m: &KeptMode, h: f64, eta: &mut [f64], eta_dd: &mut [f64], energy: &mut [f64]) {
     let mut eta_dot = vec![0.0; eta.len()];
-    fill_state(m, zeta, 0.0, h, eta, &mut eta_dot);
+    fill_state(m, 0.0, h, eta, &mut eta_dot);
     if m.rigid || m.omega_rad_s == 0.0 {
         eta_dd.fill(0.0);
         return;
     }
-    let w = m.omega_rad_s;
+    let (w, zeta) = (m.omega_rad_s, m.zeta);
     for k in 0..eta.len() {
         let (e, ed) = (eta[k], eta_dot[k]);
         eta_dd[k] = -2.0 * zeta * w * ed - w * w * e;
@@ -617,7 +632,7 @@ fn fill_mode(
 /// s cos ω_d h + c sin ω_d h) and the decay by the factor e^{−ζωh}; each block starts from the
 /// closed form at its own time, so rounding cannot accumulate beyond RESYNC steps (≈ 1e-14
 /// relative).
-fn fill_state(m: &KeptMode, zeta: f64, t0: f64, h: f64, eta: &mut [f64], eta_dot: &mut [f64]) {
+fn fill_state(m: &KeptMode, t0: f64, h: f64, eta: &mut [f64], eta_dot: &mut [f64]) {
     if m.rigid || m.omega_rad_s == 0.0 {
         for (k, (e, ed)) in eta.iter_mut().zip(eta_dot.iter_mut()).enumerate() {
             *e = m.eta0 + m.eta_dot0 * (t0 + k as f64 * h);
@@ -625,7 +640,7 @@ fn fill_state(m: &KeptMode, zeta: f64, t0: f64, h: f64, eta: &mut [f64], eta_dot
         }
         return;
     }
-    let w = m.omega_rad_s;
+    let (w, zeta) = (m.omega_rad_s, m.zeta);
     let wd = w * (1.0 - zeta * zeta).sqrt();
     let (a, b) = (m.eta0, (m.eta_dot0 + zeta * w * m.eta0) / wd);
     let (sd, cd) = (wd * h).sin_cos();
@@ -648,11 +663,11 @@ fn fill_state(m: &KeptMode, zeta: f64, t0: f64, h: f64, eta: &mut [f64], eta_dot
 /// Samples between two closed-form evaluations in [`fill_state`].
 const RESYNC: usize = 32;
 
-fn state(m: &KeptMode, zeta: f64, t: f64) -> (f64, f64) {
+fn state(m: &KeptMode, t: f64) -> (f64, f64) {
     if m.rigid || m.omega_rad_s == 0.0 {
         return (m.eta0 + m.eta_dot0 * t, m.eta_dot0);
     }
-    let w = m.omega_rad_s;
+    let (w, zeta) = (m.omega_rad_s, m.zeta);
     let wd = w * (1.0 - zeta * zeta).sqrt();
     let (s, c) = (wd * t).sin_cos();
     let decay = (-zeta * w * t).exp();

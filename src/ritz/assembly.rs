@@ -185,13 +185,13 @@ fn layout(structure: &Structure) -> (Vec<Part<'_>>, usize) {
         });
     }
     for (i, p) in structure.plates.iter().enumerate() {
-        let len = p.terms.dof();
+        let len = p.dof();
         parts.push(Part {
             id: ComponentId::Plate(i),
             attachment: &p.attachment,
             kind: ElementKind::Plate {
                 index: i,
-                length: kind.bending(p.terms.length),
+                length: plate_length_basis(kind, p),
                 width: kind.free_free(p.terms.width),
             },
             fields: vec![FieldRange::new(FieldKind::G, n, len)],
@@ -423,6 +423,42 @@ impl RitzModel {
         }
         symmetrize(&mut mass);
         mass
+    }
+
+    /// The hinge lines' dashpots as a damping matrix C, its non-zero entries (row, column):
+    /// (1/a²) S_ii' ∫Y_n Y_q dη between the kink functions as their stiffness, with the
+    /// dashpots in S (docs/theory.md §1.6). Empty without hinge lines.
+    pub fn line_damping(&self) -> Vec<(usize, usize, f64)> {
+        let mut out = Vec::new();
+        for e in &self.elements {
+            let ElementKind::Plate {
+                index,
+                length,
+                width,
+            } = &e.kind
+            else {
+                continue;
+            };
+            let p = &self.structure.plates[*index];
+            if p.hinges.is_empty() {
+                continue;
+            }
+            let iy = Integrals::new(width.as_ref());
+            let start = e.own_range().start;
+            let mut sink: Vec<Triplet<usize, usize, f64>> = Vec::new();
+            add_hinge_lines(
+                p,
+                &iy,
+                length.len(),
+                &p.hinge_function_matrix(true),
+                &mut sink,
+            );
+            out.extend(
+                sink.into_iter()
+                    .map(|t| (start + t.row, start + t.col, t.val)),
+            );
+        }
+        out
     }
 
     /// The element of a component.
@@ -696,6 +732,21 @@ pub(crate) fn beam_element(
     (me, ke)
 }
 
+/// The plate's functions along its length: the clamped family, followed by a kink per hinge
+/// line when the plate is cut ([`crate::basis::Hinged`]).
+pub(crate) fn plate_length_basis(kind: crate::basis::BasisKind, p: &Plate) -> Box<dyn Basis1d> {
+    let smooth = kind.bending(p.terms.length);
+    if p.hinges.is_empty() {
+        smooth
+    } else {
+        Box::new(crate::basis::Hinged::combined(
+            smooth,
+            p.hinge_positions(),
+            p.hinge_functions.clone(),
+        ))
+    }
+}
+
 /// Plate element (docs/theory.md §1): W = Σ g_mn X_m(x/a) Y_n(y/b + ½),
 /// T = ½∫μ|U̇ + Θ̇ × r + Ẇ n|² dA,
 /// U = (D/2)∫[W_xx² + W_yy² + 2ν W_xx W_yy + 2(1 − ν) W_xy²] dA
@@ -800,7 +851,38 @@ fn plate_element_into(
             }
         }
     }
+    // Hinge lines (docs/theory.md §1.6): the slope jump across line j is
+    // (1/a) Σ_i W_ij Σ_n h_in Y_n for the kink functions' coordinates h_in; the line springs
+    // (k/b per unit length) store ½ (1/a²) Σ S_ii' h_in h_i'q ∫Y_n Y_q dη.
+    add_hinge_lines(
+        plate,
+        &iy,
+        nx,
+        &plate.hinge_function_matrix(false),
+        own_stiffness,
+    );
     (rigid, coupling)
+}
+
+/// Adds (1/a²) S_ii' ∫Y_n Y_q dη into the kink functions' block of a plate's own matrix
+/// (`s` = [`Plate::hinge_function_matrix`]; the kinks follow the `nx` − len(S) smooth
+/// length functions).
+fn add_hinge_lines(plate: &Plate, iy: &Integrals, nx: usize, s: &[Vec<f64>], sink: &mut impl Sink) {
+    let ny = iy.m0.len();
+    let smooth = nx - s.len();
+    let a2 = plate.length * plate.length;
+    for (i, row) in s.iter().enumerate() {
+        for (k, &sik) in row.iter().enumerate() {
+            for n in 0..ny {
+                for q in 0..ny {
+                    let v = sik / a2 * iy.i00[(n, q)];
+                    if v != 0.0 {
+                        sink.add((smooth + i) * ny + n, (smooth + k) * ny + q, v);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The columns of a 6 × n map T that are not all zero: the hub's coordinates and the

@@ -158,7 +158,7 @@ fn coarser(n: usize) -> Option<usize> {
 fn dof(st: &Structure) -> usize {
     HUB_DOF
         + st.beams.iter().map(|b| b.terms.dof()).sum::<usize>()
-        + st.plates.iter().map(|p| p.terms.dof()).sum::<usize>()
+        + st.plates.iter().map(|p| p.dof()).sum::<usize>()
 }
 
 /// What accuracy to reach and within what size.

@@ -168,7 +168,7 @@ impl Scenario {
         let st = &self.structure;
         let dof = 6
             + st.beams.iter().map(|b| b.terms.dof() as u64).sum::<u64>()
-            + st.plates.iter().map(|p| p.terms.dof() as u64).sum::<u64>();
+            + st.plates.iter().map(|p| p.dof() as u64).sum::<u64>();
         let modes_bytes = MATRICES_PER_SOLVE.saturating_mul(8 * dof * dof);
         let deployment_cells =
             (self.deployment.as_ref().filter(|_| parts.deployment)).map_or(0, |d| {
@@ -178,7 +178,7 @@ impl Scenario {
                     + st.plates
                         .iter()
                         .filter(|p| p.name != d.plate)
-                        .map(|p| p.terms.dof() as u64)
+                        .map(|p| p.dof() as u64)
                         .sum::<u64>();
                 // The base's columns: every mode when no count is given, else the count asked
                 // for (or, chosen automatically, about DEPLOY_MODES_GUESS) plus at most twelve
@@ -313,7 +313,7 @@ impl Scenario {
                     st.plates
                         .iter()
                         .enumerate()
-                        .map(|(i, p)| (p.terms.dof(), ComponentId::Plate(i))),
+                        .map(|(i, p)| (p.dof(), ComponentId::Plate(i))),
                 )
                 .max_by_key(|(n, _)| *n);
             let (n, id) = biggest.unwrap_or((0, ComponentId::Hub));

@@ -119,6 +119,7 @@ pub(super) fn lower(
         accuracy,
         base: base(cx, raw)?,
         base_damping_ratio: base_damping_ratio(cx, raw)?,
+        settling: None,
         synchronisation,
         plate: plate.name.clone(),
         chain,

@@ -448,6 +448,14 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         Some(d) => Some(deployment::lower(cx, d, &structure)?),
         None => None,
     };
+    // Compliant latches stay in the deployed wing: its plate is cut along the hinge lines
+    // and joined by the latch springs (docs/theory.md §1.6).
+    let structure = match (&deployment, &raw.deployment) {
+        (Some(d), Some(rd)) => d
+            .latched_structure(&structure)
+            .map_err(|e| cx.invalid(rd.span(), "deployment.latch", e.to_string()))?,
+        _ => structure,
+    };
     let montecarlo = match &raw.montecarlo {
         Some(m) => Some(montecarlo::lower(
             cx,

@@ -71,7 +71,7 @@ pub(super) fn select(
             .sum::<usize>()
         + (structure.plates().iter().enumerate())
             .filter(|(i, _)| !automatic.contains(&ComponentId::Plate(*i)))
-            .map(|(_, p)| p.terms.dof())
+            .map(|(_, p)| p.dof())
             .sum::<usize>();
     let max_dof = match given_max_dof {
         Some((n, m)) => {

@@ -552,6 +552,28 @@ pub struct Plate {
     pub(crate) bending_stiffness: f64,
     pub(crate) poisson_ratio: f64,
     pub(crate) terms: PlateTerms,
+    pub(crate) hinges: Vec<LineHinge>,
+    /// W (functions × lines): the plate's kink function i is Σ_j W_ij K_j (the identity for
+    /// independent hinges; one row for hinges an ideal cable ties).
+    pub(crate) hinge_functions: Vec<Vec<f64>>,
+    /// Stiffness coupling the lines' rotations besides each line's own spring (lines × lines,
+    /// N·m/rad; an elastic cable's), empty for none.
+    pub(crate) hinge_coupling: Vec<Vec<f64>>,
+}
+
+/// A latched hinge line across a plate's width: the compliant latch of a folded array, kept
+/// in the deployed wing's model (docs/theory.md §1.6). The plate is cut along the line x = `at`
+/// and the two sides are joined by a continuous line hinge of rotational stiffness
+/// `stiffness`/b per unit length (and a dashpot `damping`/b): a uniform relative rotation θ
+/// about the line stores ½ k_L θ², as the latch spring of the deployment does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LineHinge {
+    /// Distance of the line from the root edge, m (0 is the root hinge).
+    pub at: f64,
+    /// k_L, N·m/rad, for a uniform rotation about the line.
+    pub stiffness: f64,
+    /// c_L, N·m·s/rad, likewise.
+    pub damping: f64,
 }
 
 impl Plate {
@@ -605,7 +627,138 @@ impl Plate {
             bending_stiffness,
             poisson_ratio,
             terms: s.terms,
+            hinges: Vec::new(),
+            hinge_functions: Vec::new(),
+            hinge_coupling: Vec::new(),
         })
+    }
+
+    /// The plate cut along `hinges` (ascending positions in [0, a), positive finite stiffness,
+    /// finite damping ≥ 0), each line joined by its hinge spring ([`LineHinge`]).
+    pub fn with_hinges(mut self, hinges: Vec<LineHinge>) -> Result<Self, StructureError> {
+        let mut last = -1.0;
+        for (i, h) in hinges.iter().enumerate() {
+            let reason = if !(h.at >= 0.0 && h.at < self.length && h.at > last) {
+                Some(format!(
+                    "hinge line {} at {:e} m: positions must ascend within [0, {:e}) m",
+                    i + 1,
+                    h.at,
+                    self.length
+                ))
+            } else if !(h.stiffness.is_finite() && h.stiffness > 0.0) {
+                Some(format!(
+                    "hinge line {}: stiffness {:e} N·m/rad must be positive and finite",
+                    i + 1,
+                    h.stiffness
+                ))
+            } else if !(h.damping.is_finite() && h.damping >= 0.0) {
+                Some(format!(
+                    "hinge line {}: damping {:e} N·m·s/rad must be finite and not negative",
+                    i + 1,
+                    h.damping
+                ))
+            } else {
+                None
+            };
+            if let Some(reason) = reason {
+                return Err(StructureError::InvalidHinge { reason });
+            }
+            last = h.at;
+        }
+        let n = hinges.len();
+        self.hinges = hinges;
+        self.hinge_functions = (0..n)
+            .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+            .collect();
+        self.hinge_coupling = Vec::new();
+        Ok(self)
+    }
+
+    /// The hinge lines moving together: the plate's kink functions become the combinations
+    /// `functions` (rows of weights on the lines' kinks; an ideal cable's one row), and
+    /// `coupling` (lines × lines, N·m/rad, symmetric; empty for none) adds stiffness between
+    /// the lines' rotations (an elastic cable's). Call after [`Plate::with_hinges`].
+    pub fn with_tied_hinges(
+        mut self,
+        functions: Vec<Vec<f64>>,
+        coupling: Vec<Vec<f64>>,
+    ) -> Result<Self, StructureError> {
+        let n = self.hinges.len();
+        let bad = |v: &Vec<Vec<f64>>, rows: Option<usize>| {
+            rows.is_some_and(|r| v.len() != r)
+                || v.iter()
+                    .any(|r| r.len() != n || r.iter().any(|x| !x.is_finite()))
+        };
+        if functions.is_empty() || bad(&functions, None) {
+            return Err(StructureError::InvalidHinge {
+                reason: format!("tied hinge functions need rows of {n} finite weights"),
+            });
+        }
+        if !coupling.is_empty() && bad(&coupling, Some(n)) {
+            return Err(StructureError::InvalidHinge {
+                reason: format!("a hinge coupling is {n} × {n} finite values"),
+            });
+        }
+        self.hinge_functions = functions;
+        self.hinge_coupling = coupling;
+        Ok(self)
+    }
+
+    /// The stiffness (`damping` = false) or damping between the plate's kink functions for a
+    /// uniform rotation of each line: S_ii' = Σ_jl W_ij (diag(k or c) + coupling)_jl W_i'l
+    /// (the coupling is stiffness only), per radian², N·m/rad or N·m·s/rad.
+    pub fn hinge_function_matrix(&self, damping: bool) -> Vec<Vec<f64>> {
+        let w = &self.hinge_functions;
+        let n = self.hinges.len();
+        let line = |j: usize, l: usize| -> f64 {
+            let own = if j == l {
+                if damping {
+                    self.hinges[j].damping
+                } else {
+                    self.hinges[j].stiffness
+                }
+            } else {
+                0.0
+            };
+            let c = if damping {
+                0.0
+            } else {
+                self.hinge_coupling.get(j).map_or(0.0, |r| r[l])
+            };
+            own + c
+        };
+        w.iter()
+            .map(|wi| {
+                w.iter()
+                    .map(|wk| {
+                        (0..n)
+                            .flat_map(|j| (0..n).map(move |l| (j, l)))
+                            .map(|(j, l)| wi[j] * line(j, l) * wk[l])
+                            .sum()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The weights W of the kink functions on the lines ([`Plate::with_tied_hinges`]).
+    pub fn hinge_functions(&self) -> &[Vec<f64>] {
+        &self.hinge_functions
+    }
+
+    /// The latched hinge lines ([`Plate::with_hinges`]; none for an uncut plate).
+    pub fn hinges(&self) -> &[LineHinge] {
+        &self.hinges
+    }
+
+    /// The hinge lines' positions as fractions ξ = x/a of the length.
+    pub fn hinge_positions(&self) -> Vec<f64> {
+        self.hinges.iter().map(|h| h.at / self.length).collect()
+    }
+
+    /// Number of Ritz coordinates: (length terms + kink functions) × width terms.
+    pub fn dof(&self) -> usize {
+        (self.terms.length + self.hinge_functions.len()) * self.terms.width
     }
 
     /// Unique name.

@@ -178,6 +178,12 @@ pub enum StructureError {
         /// Outer radius (or half length for end caps), m.
         radius: f64,
     },
+    /// A plate's hinge lines out of order or with a bad spring ([`super::Plate::with_hinges`]).
+    #[error("{reason}")]
+    InvalidHinge {
+        /// Why.
+        reason: String,
+    },
     /// An inertia given with neither 3 nor 6 values.
     #[error("inertia needs 3 principal values or 6 [Ixx, Iyy, Izz, Ixy, Ixz, Iyz], got {len}")]
     InertiaLength {
@@ -285,6 +291,7 @@ impl StructureError {
                 Field::Name
             }
             StructureError::WallTooThick { .. } => Field::Wall,
+            StructureError::InvalidHinge { .. } => Field::Length,
             StructureError::InertiaLength { .. }
             | StructureError::InertiaEntry { .. }
             | StructureError::InertiaNotPositive { .. }

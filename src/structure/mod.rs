@@ -6,7 +6,7 @@ pub mod material;
 pub mod rigid;
 
 pub use components::{
-    Attachment, Beam, BeamSection, BeamSpec, BeamTerms, Cylinder, Frame, Hub, HubMotion,
+    Attachment, Beam, BeamSection, BeamSpec, BeamTerms, Cylinder, Frame, Hub, HubMotion, LineHinge,
     LumpedMass, Plate, PlateSpec, PlateStiffness, PlateTerms, MAX_TERMS,
 };
 pub(crate) use error::{in_range, name, point, unit};

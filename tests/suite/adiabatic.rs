@@ -11,11 +11,21 @@ use super::common::edited_example as scenario;
 
 /// `sc`'s deployment with `modes` base modes, the integrator and tolerance given, run.
 fn run(sc: &Scenario, modes: usize, integrator: Integrator, tol: f64) -> DeploymentResult {
+    let d = sc.deployment.clone().unwrap();
+    // Compliant latches run until their motion has decayed (the settling these tests check),
+    // not the default one latch period.
+    let settling = match &d.latch {
+        flexcraft::deploy::LatchModel::Compliant { stiffness, .. } => Some(
+            flexcraft::deploy::Settle::decayed(&d.chain, stiffness, d.synchronisation),
+        ),
+        flexcraft::deploy::LatchModel::Rigid => None,
+    };
     let d = Deployment {
         base: BaseKind::Flexible { modes: Some(modes) },
         integrator,
         tolerance: tol,
-        ..sc.deployment.clone().unwrap()
+        settling,
+        ..d
     };
     simulate_coupled(&sc.structure, &d).unwrap().1
 }

@@ -1299,6 +1299,7 @@ fn rigid_run(case: &PlanarCase) -> flexcraft::deploy::DeploymentResult {
         integrator: flexcraft::deploy::Integrator::Explicit,
         latch: flexcraft::deploy::LatchModel::Rigid,
         base_damping_ratio: 0.0,
+        settling: None,
         tolerance: 1e-12,
         accuracy: 1e-3,
     })

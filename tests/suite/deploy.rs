@@ -53,6 +53,7 @@ pub fn deployment(chain: Chain, latching: Latching, tol: f64) -> Deployment {
         integrator: flexcraft::deploy::Integrator::Explicit,
         latch: flexcraft::deploy::LatchModel::Rigid,
         base_damping_ratio: 0.0,
+        settling: None,
         tolerance: tol,
         accuracy: 1e-3,
     }

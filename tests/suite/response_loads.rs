@@ -118,7 +118,7 @@ fn plate_hinge_line_moments_match_the_beam_mode() {
         initial_rate: 0.0,
     };
     let mut channels = standard_channels(&model);
-    channels.extend(latch_channels(&model, "plate", &[hinge; 3]));
+    channels.extend(latch_channels(&model, "plate", &[hinge; 3], &[a / 3.0; 3]));
     let settings = ResponseSettings {
         duration: 0.0,
         output_rate: 1.0,
