@@ -277,6 +277,10 @@ pub fn valid_text(what: &str, text: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Largest elastic deflection, as a fraction of the component's length, that the linear
+/// (small-deformation) model is trusted with; above it a warning says so.
+pub const SMALL_DEFLECTION_FRACTION: f64 = 0.1;
+
 #[cfg(test)]
 mod tests {
     use super::*;

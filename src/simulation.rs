@@ -5,7 +5,7 @@
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{self, DeployError, DeploymentResult};
 use crate::response::channels::standard_channels;
-use crate::response::handover::{hand_over_coupled, line_damping_ratios};
+use crate::response::handover::hand_over_coupled;
 use crate::response::loads::{beam_root_channels, latch_channels};
 use crate::response::{Channel, Handover, ModalResponse, ResponseError, ResponseHistory};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
@@ -122,7 +122,7 @@ impl Simulation {
                     &handover.modal_velocity,
                     settings,
                 )
-                .with_line_damping(&line_damping_ratios(&model, &modes));
+                .with_line_damping(&modes.line_damping_ratios(&model));
                 if let Some(req) = settings.modes {
                     if req > modal.available_elastic {
                         warnings.push(Warning::ModesClamped {
@@ -178,9 +178,7 @@ impl Simulation {
     }
 }
 
-/// Largest elastic deflection, as a fraction of the component's length, that the linear
-/// (small-deformation) model is trusted with; above it a warning says so.
-pub const SMALL_DEFLECTION_FRACTION: f64 = 0.1;
+pub use crate::limits::SMALL_DEFLECTION_FRACTION;
 
 /// Warnings for beam and plate tips whose peak elastic deflection exceeds
 /// [`SMALL_DEFLECTION_FRACTION`] of the component's length: the linear model's numbers are

@@ -519,6 +519,7 @@ pub fn simulate_coupled_observed(
         truncation_check(st, d, &c, &mut r)?;
         (c, r)
     };
+    large_base_deflections(st, &c, &mut r);
     if let BaseKind::Flexible {
         modes: Some(requested),
     } = d.base
@@ -536,6 +537,30 @@ pub fn simulate_coupled_observed(
         }
     }
     Ok((c, r))
+}
+
+/// [`Warning::LargeDeflection`] for every base beam whose tip deflects (in the samples) by
+/// more than [`crate::limits::SMALL_DEFLECTION_FRACTION`] of its length: the base's modes
+/// and the hand-over's momentum in the undeformed geometry assume small deflections.
+fn large_base_deflections(st: &Structure, c: &Coupled, r: &mut DeploymentResult) {
+    let fraction = crate::limits::SMALL_DEFLECTION_FRACTION;
+    for (i, b) in c.base.beams.iter().enumerate() {
+        let Some(length) = st.beams.iter().find(|x| x.name == b.name).map(|x| x.length) else {
+            continue;
+        };
+        let peak = (r.samples.iter())
+            .filter_map(|s| s.body.as_ref()?.beam_tips.get(i).copied())
+            .map(|t| t[1].hypot(t[2]))
+            .fold(0.0_f64, f64::max);
+        if peak > fraction * length {
+            r.warnings.push(Warning::LargeDeflection {
+                label: format!("{} tip during the deployment", b.name),
+                peak_m: peak,
+                length_m: length,
+                fraction,
+            });
+        }
+    }
 }
 
 /// Rigid latches on an elastic base: every latch's impact again with half of the kept base

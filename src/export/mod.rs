@@ -280,7 +280,13 @@ impl ExportModel {
     ) -> Result<Self, ExportError> {
         let elastic: Vec<_> = modes.elastic().collect();
         let kept = settings.modes.unwrap_or(elastic.len()).min(elastic.len());
-        let zeta = damping_ratios(&settings.damping, kept)?;
+        // The latch lines' dashpots (docs/theory.md §1.6) add to the damping asked for.
+        let lines = modes.line_damping_ratios(model);
+        let zeta: Vec<f64> = damping_ratios(&settings.damping, kept)?
+            .into_iter()
+            .zip(elastic.iter())
+            .map(|(z, m)| (z + lines[m.number - 1]).min(crate::ritz::modes::MAX_ZETA))
+            .collect();
         let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
         let chosen: Vec<(&crate::ritz::Mode, f64)> = rigid
             .iter()

@@ -15,7 +15,7 @@ pub mod stats;
 use crate::deploy::coupled::Coupled;
 use crate::deploy::{simulate_coupled_with, Deployment, DeploymentResult, LatchModel};
 use crate::response::channels::standard_channels;
-use crate::response::handover::{hand_over_coupled, line_damping_ratios};
+use crate::response::handover::hand_over_coupled;
 use crate::response::{Channel, ModalResponse, ResponseError};
 use crate::ritz::{ModalAnalysis, RitzError, RitzModel};
 use crate::scenario::{DeploymentOverrides, OverrideValue, Scenario};
@@ -429,7 +429,7 @@ impl ResponseModel {
             &h.modal_velocity,
             settings,
         )
-        .with_line_damping(&line_damping_ratios(&self.model, &self.modes));
+        .with_line_damping(&self.modes.line_damping_ratios(&self.model));
         let history = modal.sample(&self.modes, &self.channels, settings);
         Ok((0..self.channels.len())
             .map(|k| history.peak(k).0)

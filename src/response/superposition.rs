@@ -49,8 +49,7 @@ pub struct ModalResponse {
     pub captured_energy_fraction: f64,
 }
 
-/// The largest modal damping ratio the response's underdamped closed form takes.
-pub const MAX_ZETA: f64 = 0.95;
+pub use crate::ritz::modes::MAX_ZETA;
 
 /// Sampled response.
 #[derive(Debug, Clone)]

@@ -461,3 +461,26 @@ fn appendage_mass(model: &RitzModel, mrr: &Mat<f64>) -> [f64; 6] {
 pub fn is_elastic(id: ComponentId) -> bool {
     matches!(id, ComponentId::Beam(_) | ComponentId::Plate(_))
 }
+
+/// The largest modal damping ratio the response's and the export's underdamped closed forms
+/// take (the latch lines' dashpots are capped there).
+pub const MAX_ZETA: f64 = 0.95;
+
+impl ModalAnalysis {
+    /// Every mode's damping ratio from `model`'s hinge-line dashpots (docs/theory.md §1.6),
+    /// φ_jᵀ C φ_j / (2ω_j) with C = [`RitzModel::line_damping`] (the diagonal of the damping
+    /// in modal coordinates; zero for rigid modes and without hinge lines).
+    pub fn line_damping_ratios(&self, model: &super::RitzModel) -> Vec<f64> {
+        let c = model.line_damping();
+        self.modes
+            .iter()
+            .map(|m| {
+                if m.rigid || m.omega_rad_s <= 0.0 || c.is_empty() {
+                    return 0.0;
+                }
+                let q: f64 = c.iter().map(|&(i, j, v)| m.shape[i] * v * m.shape[j]).sum();
+                q / (2.0 * m.omega_rad_s)
+            })
+            .collect()
+    }
+}
