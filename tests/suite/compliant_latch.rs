@@ -790,41 +790,10 @@ fn the_deployed_wing_stands_on_its_latch_springs() {
             "synchronisation = \"cable\"\ncable_stiffness = 150.0",
         ),
     ] {
-        let src = format!(
-            r#"
-name = "held wing on compliant latches"
-[hub]
-motion = "fixed"
-mass = 1000.0
-inertia = [1000.0, 1000.0, 1000.0]
-center_of_mass = [0.0, 0.0, 0.0]
-[[plates]]
-name = "wing"
-parent = "hub"
-root = [0.0, 0.0, 0.0]
-length_axis = [1.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-length = 6.0
-width = 2.0
-areal_density = 5.0
-bending_stiffness = 1e9
-poisson_ratio = 0.3
-terms = {{ length = 6, width = 4 }}
-[deployment]
-plate = "wing"
-panel_lengths = [1.5, 2.5, 2.0]
-{key}
-end_time = 60.0
-[deployment.latch]
-model = "compliant"
-stiffness = [300.0, 200.0, 120.0]
-damping = 1.0
-[deployment.hinge]
-stiffness = 1.0
-preload_angle = 0.2
-damping = 0.0
-friction = 0.0
-"#
+        let src = held_wing(
+            1e9,
+            &format!("{key}\nend_time = 60.0"),
+            "stiffness = [300.0, 200.0, 120.0]\ndamping = 1.0",
         );
         let sc = Scenario::from_toml_str(&src, "held.toml").unwrap();
         let d = sc.deployment.as_ref().unwrap();
@@ -879,45 +848,11 @@ friction = 0.0
 /// spring's energy or hinge lines at the wrong place (the panels are unequal) fails it.
 #[test]
 fn the_response_goes_on_as_the_latched_deployment_does() {
-    let base = r#"
-name = "held wing, stiff latches"
-[hub]
-motion = "fixed"
-mass = 1000.0
-inertia = [1000.0, 1000.0, 1000.0]
-center_of_mass = [0.0, 0.0, 0.0]
-[[plates]]
-name = "wing"
-parent = "hub"
-root = [0.0, 0.0, 0.0]
-length_axis = [1.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-length = 6.0
-width = 2.0
-areal_density = 5.0
-bending_stiffness = 1e7
-poisson_ratio = 0.3
-terms = { length = 6, width = 4 }
-[deployment]
-plate = "wing"
-panel_lengths = [1.5, 2.5, 2.0]
-synchronisation = "none"
-end_time = 200.0
-output_rate = 400.0
-[deployment.latch]
-model = "compliant"
-stiffness = [3.0e4, 2.0e4, 1.2e4]
-damping = 3.0
-SETTLE
-[deployment.hinge]
-stiffness = 1.0
-preload_angle = 0.2
-damping = 0.0
-friction = 0.0
-[response]
-duration = 2.0
-output_rate = 400.0
-"#;
+    let base = held_wing(
+        1e7,
+        "synchronisation = \"none\"\nend_time = 200.0\noutput_rate = 400.0",
+        "stiffness = [3.0e4, 2.0e4, 1.2e4]\ndamping = 3.0\nSETTLE",
+    ) + "[response]\nduration = 2.0\noutput_rate = 400.0\n";
     let a =
         Scenario::from_toml_str(&base.replace("SETTLE", "settle_time = 0.5"), "a.toml").unwrap();
     let b =
@@ -971,4 +906,44 @@ output_rate = 400.0
             k + 1
         );
     }
+}
+
+/// A wing of three unequal panels (1.5, 2.5, 2 m; plate stiffness `d` N·m) on a held hub,
+/// hinge springs 1 N·m/rad preloaded 0.2 rad, compliant latches: `deployment` and `latch`
+/// are the lines of those tables beyond the common ones.
+fn held_wing(d: f64, deployment: &str, latch: &str) -> String {
+    format!(
+        r#"
+name = "held wing on compliant latches"
+[hub]
+motion = "fixed"
+mass = 1000.0
+inertia = [1000.0, 1000.0, 1000.0]
+center_of_mass = [0.0, 0.0, 0.0]
+[[plates]]
+name = "wing"
+parent = "hub"
+root = [0.0, 0.0, 0.0]
+length_axis = [1.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+length = 6.0
+width = 2.0
+areal_density = 5.0
+bending_stiffness = {d:e}
+poisson_ratio = 0.3
+terms = {{ length = 6, width = 4 }}
+[deployment]
+plate = "wing"
+panel_lengths = [1.5, 2.5, 2.0]
+{deployment}
+[deployment.latch]
+model = "compliant"
+{latch}
+[deployment.hinge]
+stiffness = 1.0
+preload_angle = 0.2
+damping = 0.0
+friction = 0.0
+"#
+    )
 }
