@@ -75,6 +75,9 @@ pub struct Channel {
     pub order: Order,
     /// A constant added to c · q (or c · q̈): a static part the linear model does not carry.
     pub offset: f64,
+    /// A second row c_v whose product with q̇ is added too (a dashpot's share: a compliant
+    /// latch's moment −k_L θ − c_L θ̇); `None` for most channels.
+    pub rate_row: Option<Vec<f64>>,
 }
 
 /// The standard channels of a model: beams' tips, plates' tip corners, the hub.
@@ -114,6 +117,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                         row,
                         order: Order::Displacement,
                         offset: 0.0,
+                        rate_row: None,
                     });
                 }
             }
@@ -144,6 +148,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                         row,
                         order: Order::Displacement,
                         offset: 0.0,
+                        rate_row: None,
                     });
                 }
             }
@@ -178,6 +183,7 @@ pub fn standard_channels(model: &RitzModel) -> Vec<Channel> {
                 row,
                 order: Order::Displacement,
                 offset: 0.0,
+                rate_row: None,
             });
         }
     }

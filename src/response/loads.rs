@@ -12,15 +12,18 @@
 //!   the moment about the root point r is M = Ḣ_S − (r − c) × F (small motions: the root's
 //!   own velocity times p_S is of second order). Structure axes (the hub's body axes).
 //! * **Latch moments in the deployed wing.** The wing is one plate in the response; the
-//!   hinge line k at x_k = (k − 1) a/N carries the moment T_b = Ḣ_b the inboard part exerts
-//!   on the outboard strip x ∈ [x_k, a] about the width axis e_b, with
+//!   hinge line k at x_k (the panel lengths inboard of it) carries the moment T_b = Ḣ_b
+//!   the inboard part exerts on the outboard strip x ∈ [x_k, a] about the width axis e_b,
+//!   with
 //!   H_b = −μ ∫∫_{x ≥ x_k} (x − x_k) v_n dA and v_n = n·(U̇ + Θ̇ × r) + Ẇ the normal velocity
 //!   (the attachment's translation U and rotation Θ, r from the root edge's centre). On the
 //!   hinge coordinate α_k (whose opening turns the outboard panels by (−1)^k about
 //!   e_a × n = −e_b) this is the generalized moment Q_k = (−1)^{k+1} T_b: the hinge spring and
 //!   the latch together. The latch's share is Q_k minus the hinge spring's moment at the
 //!   latch angle, the static preload the unstressed plate does not carry, so that a settled
-//!   deployment and the response's start agree.
+//!   deployment and the response's start agree. A wing cut along compliant latch lines
+//!   (docs/theory.md §1.6) reports the latch's own moment from the lines' rotation and rate
+//!   instead ([`latch_line_channels`]). The lines are at the panels' true positions.
 
 use super::channels::{Channel, ChannelKind, Order};
 use crate::basis::{Basis1d, Quadrature};
@@ -67,6 +70,7 @@ pub fn beam_root_channels(model: &RitzModel) -> Vec<Channel> {
                     row: rows.iter().map(|r| r[k]).collect(),
                     order: Order::Acceleration,
                     offset: 0.0,
+                    rate_row: None,
                 });
             }
         }
@@ -94,6 +98,9 @@ pub fn latch_channels(
         return Vec::new();
     };
     let p = &st.plates[pi];
+    if !p.hinges.is_empty() && p.hinges.len() == hinges.len() {
+        return latch_line_channels(model, e, p, hinges, length.len(), width.as_ref());
+    }
     let (a, b, mu) = (p.length, p.width, p.areal_density);
     // Hinge k's line at the panels' lengths inboard of it (the deployment's panels, equal or
     // not); the length family's kinks (latch lines) break the quadrature there.
@@ -142,6 +149,57 @@ pub fn latch_channels(
                 row,
                 order: Order::Acceleration,
                 offset: -h.moment(h.latch_angle, 0.0),
+                rate_row: None,
+            }
+        })
+        .collect()
+}
+
+/// The compliant latches' own moments on a wing cut along its latch lines (docs/theory.md
+/// §1.6), as in the deployment: M_j = −k_L,j (α_j − α_j^L) − c_L,j α̇_j. Line j turns by
+/// the mean θ̄_j = (1/a) Σ_i W_ij Σ_n h_in ∫Y_n dη of its kink functions' coordinates, and
+/// α_j − α_j^eq = d_j θ̄_j about the equilibrium α_j^eq = (k_j α_j^ref + k_L,j α_j^L)/(k_j +
+/// k_L,j) the straight model stands for: a displacement row −k_L,j d_j ∂θ̄_j/∂q, a rate row
+/// −c_L,j d_j ∂θ̄_j/∂q and the constant −k_L,j (α_j^eq − α_j^L). The latch's share only: the
+/// hinge spring's and, with a cable, the cable's moments through the line are not in it.
+/// The lines hold k_L + k and c_L + c; the hinges give k and c.
+fn latch_line_channels(
+    model: &RitzModel,
+    e: &crate::ritz::assembly::Element,
+    p: &crate::structure::Plate,
+    hinges: &[Hinge],
+    nx: usize,
+    width: &dyn Basis1d,
+) -> Vec<Channel> {
+    let w = p.hinge_functions();
+    let ny = width.len();
+    let smooth = nx - w.len();
+    let own = e.own_range().start;
+    let y_means = means(width, 0.0, |_| 1.0, &[]);
+    hinges
+        .iter()
+        .zip(p.hinges())
+        .enumerate()
+        .map(|(j, (h, line))| {
+            let (kl, cl) = (line.stiffness - h.stiffness, line.damping - h.damping);
+            let d = if j % 2 == 0 { -1.0 } else { 1.0 };
+            let eq = (h.stiffness * h.reference_angle + kl * h.latch_angle) / line.stiffness;
+            let mut dtheta = vec![0.0; model.dof()];
+            for (i, wi) in w.iter().enumerate() {
+                for (n, yn) in y_means.iter().enumerate() {
+                    dtheta[own + (smooth + i) * ny + n] += wi[j] * yn / p.length;
+                }
+            }
+            let k = j + 1;
+            Channel {
+                name: format!("latch_moment_{k}"),
+                label: format!("latch moment, hinge {k}"),
+                unit: "N·m",
+                kind: ChannelKind::LatchMoment { hinge: k },
+                row: dtheta.iter().map(|v| -kl * d * v).collect(),
+                order: Order::Displacement,
+                offset: -kl * (eq - h.latch_angle),
+                rate_row: Some(dtheta.iter().map(|v| -cl * d * v).collect()),
             }
         })
         .collect()

@@ -172,6 +172,7 @@ fn station_channels(
             row,
             order: Order::Acceleration,
             offset: 0.0,
+            rate_row: None,
         });
     }
     out

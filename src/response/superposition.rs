@@ -159,24 +159,29 @@ impl ModalResponse {
         let nm = self.modes.len();
         let times: Vec<f64> = (0..rows).map(|k| k as f64 / settings.output_rate).collect();
         let mut eta = Mat::<f64>::zeros(rows, nm);
+        let mut eta_dot = Mat::<f64>::zeros(rows, nm);
         let mut eta_dd = Mat::<f64>::zeros(rows, nm);
         let mut energy = vec![0.0; rows];
         let h = 1.0 / settings.output_rate;
-        let mut acc = vec![0.0; rows];
+        let (mut vel, mut acc) = (vec![0.0; rows], vec![0.0; rows]);
         for (j, m) in self.modes.iter().enumerate() {
             let col = eta
                 .col_mut(j)
                 .try_as_col_major_mut()
                 .expect("a fresh Mat is column-major")
                 .as_slice_mut();
-            fill_mode(m, h, col, &mut acc, &mut energy);
-            for (k, a) in acc.iter().enumerate() {
-                eta_dd[(k, j)] = *a;
+            fill_mode(m, h, col, &mut vel, &mut acc, &mut energy);
+            for k in 0..rows {
+                eta_dot[(k, j)] = vel[k];
+                eta_dd[(k, j)] = acc[k];
             }
         }
         let mut values = &eta * self.gains(modal, channels, Order::Displacement);
         if channels.iter().any(|c| c.order == Order::Acceleration) {
             values += &eta_dd * self.gains(modal, channels, Order::Acceleration);
+        }
+        if channels.iter().any(|c| c.rate_row.is_some()) {
+            values += &eta_dot * self.rate_gains(modal, channels);
         }
         for (c, ch) in channels.iter().enumerate() {
             if ch.offset != 0.0 {
@@ -214,6 +219,17 @@ impl ModalResponse {
         })
     }
 
+    /// The rate gains G_jc = c_v · φ_j of the channels with a rate row (0 for the others).
+    fn rate_gains(&self, modal: &ModalAnalysis, channels: &[Channel]) -> Mat<f64> {
+        Mat::from_fn(self.modes.len(), channels.len(), |j, c| {
+            let Some(row) = &channels[c].rate_row else {
+                return 0.0;
+            };
+            let shape = &modal.modes[self.modes[j].number - 1].shape;
+            row.iter().zip(shape).map(|(a, b)| a * b).sum::<f64>()
+        })
+    }
+
     /// Kept mode j's η(t) as a wave sum: η₀ + η̇₀t for a rigid mode, otherwise
     /// e^{−ζωt}(η₀ cos ω_d t + (η̇₀ + ζωη₀)/ω_d · sin ω_d t).
     fn mode_signal(&self, j: usize) -> WaveSum {
@@ -242,9 +258,10 @@ impl ModalResponse {
     /// Every channel as a sum of damped sinusoids, its value in closed form at any time:
     /// offset + Σ_j (G_jc η_j or G_jc η̈_j).
     pub fn signals(&self, modal: &ModalAnalysis, channels: &[Channel]) -> Vec<WaveSum> {
-        let (gd, ga) = (
+        let (gd, ga, gv) = (
             self.gains(modal, channels, Order::Displacement),
             self.gains(modal, channels, Order::Acceleration),
+            self.rate_gains(modal, channels),
         );
         let modes: Vec<WaveSum> = (0..self.modes.len()).map(|j| self.mode_signal(j)).collect();
         (0..channels.len())
@@ -254,14 +271,15 @@ impl ModalResponse {
                     ..WaveSum::default()
                 };
                 for (j, m) in modes.iter().enumerate() {
-                    let (d, a) = (gd[(j, c)], ga[(j, c)]);
-                    s.constant += d * m.constant;
+                    let (d, a, v) = (gd[(j, c)], ga[(j, c)], gv[(j, c)]);
+                    s.constant += d * m.constant + v * m.slope;
                     s.slope += d * m.slope;
                     for w in &m.waves {
-                        let acc = w.derivative().derivative();
+                        let vel = w.derivative();
+                        let acc = vel.derivative();
                         s.waves.push(Wave {
-                            p: d * w.p + a * acc.p,
-                            q: d * w.q + a * acc.q,
+                            p: d * w.p + v * vel.p + a * acc.p,
+                            q: d * w.q + v * vel.q + a * acc.q,
                             ..*w
                         });
                     }
@@ -359,6 +377,14 @@ impl ModalResponse {
         };
         let (id, gd) = order_of(Order::Displacement);
         let (ia, ga) = order_of(Order::Acceleration);
+        // The channels with a rate row: their η̇ share is added after.
+        let iv: Vec<usize> = (0..channels.len())
+            .filter(|&c| channels[c].rate_row.is_some())
+            .collect();
+        let gv = {
+            let g = self.rate_gains(modal, channels);
+            Mat::from_fn(g.nrows(), iv.len(), |j, k| g[(j, iv[k])])
+        };
         let nm = self.modes.len();
         let h = grid.spacing();
         let chunk = PEAK_CHUNK.min(range.1 - range.0 + 1);
@@ -400,6 +426,7 @@ impl ModalResponse {
                     eddd[(i, j)] = -2.0 * zeta * w * xdd - w * w * xd;
                 }
             }
+            // Every channel has one order (its values copied), and some a rate share (added).
             for (idx, g, x, dx) in [(&id, &gd, &e, &ed), (&ia, &ga, &edd, &eddd)] {
                 if idx.is_empty() {
                     continue;
@@ -408,6 +435,15 @@ impl ModalResponse {
                 for (k, &c) in idx.iter().enumerate() {
                     values.col_mut(c).subrows_mut(0, rows).copy_from(v.col(k));
                     slopes.col_mut(c).subrows_mut(0, rows).copy_from(dv.col(k));
+                }
+            }
+            if !iv.is_empty() {
+                let (v, dv) = (ed.subrows(0, rows) * &gv, edd.subrows(0, rows) * &gv);
+                for (k, &c) in iv.iter().enumerate() {
+                    for i in 0..rows {
+                        values[(i, c)] += v[(i, k)];
+                        slopes[(i, c)] += dv[(i, k)];
+                    }
                 }
             }
             for (c, ch) in channels.iter().enumerate() {
@@ -609,11 +645,17 @@ const SEGMENTS: usize = 8;
 /// Grid intervals evaluated together in [`ModalResponse::peaks`].
 const PEAK_CHUNK: usize = 2048;
 
-/// Samples at t_k = k·h of one mode into `eta` and its acceleration
+/// Samples at t_k = k·h of one mode into `eta`, its rate into `eta_dot` and its acceleration
 /// η̈ = −2ζωη̇ − ω²η into `eta_dd`, adding its energy to `energy` (elastic modes).
-fn fill_mode(m: &KeptMode, h: f64, eta: &mut [f64], eta_dd: &mut [f64], energy: &mut [f64]) {
-    let mut eta_dot = vec![0.0; eta.len()];
-    fill_state(m, 0.0, h, eta, &mut eta_dot);
+fn fill_mode(
+    m: &KeptMode,
+    h: f64,
+    eta: &mut [f64],
+    eta_dot: &mut [f64],
+    eta_dd: &mut [f64],
+    energy: &mut [f64],
+) {
+    fill_state(m, 0.0, h, eta, eta_dot);
     if m.rigid || m.omega_rad_s == 0.0 {
         eta_dd.fill(0.0);
         return;

@@ -185,6 +185,7 @@ fn free_hub_balances_the_root_loads() {
             row: (0..n).map(|j| hub[(k, j)]).collect(),
             order: Order::Acceleration,
             offset: 0.0,
+            rate_row: None,
         });
     }
     let hist = resp.sample(&modal, &channels, &settings);
