@@ -34,7 +34,7 @@ impl Hinged {
         Self::combined(inner, lines, weights)
     }
 
-    /// `inner` extended by the kink combinations F_i = Σ_k `weights`[i][k] K_k (lines tied,
+    /// `inner` extended by the kink combinations F_i = Σ_k W_ik K_k, W = `weights` (lines tied,
     /// e.g. by an ideal cable).
     pub fn combined(inner: Box<dyn Basis1d>, lines: Vec<f64>, weights: Vec<Vec<f64>>) -> Self {
         Self {

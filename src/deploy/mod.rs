@@ -641,8 +641,9 @@ impl Deployment {
     /// The compliant latches as hinge lines of the deployed wing (docs/theory.md §1.6): hinge
     /// i's line at the sum of the panel lengths inboard of it (hinge 1 at the root edge),
     /// with its latch spring and dashpot in parallel with the hinge's own spring and damper
-    /// (which keep acting once latched, as in the run; its friction is left out). Empty with rigid latches (the latched wing is one
-    /// plate).
+    /// (which keep acting once latched, as in the run; its friction is left out). Empty
+    /// with rigid latches (the latched wing is one plate). The lines' rest rotations are
+    /// zero here; [`Deployment::latched_structure`] sets them.
     pub fn latch_lines(&self) -> Vec<crate::structure::LineHinge> {
         let LatchModel::Compliant {
             stiffness, damping, ..
@@ -661,6 +662,7 @@ impl Deployment {
                     at,
                     stiffness: k + h.stiffness,
                     damping: c + h.damping,
+                    rest: 0.0,
                 };
                 at += p.length;
                 line
@@ -670,11 +672,20 @@ impl Deployment {
 
     /// `st` with the deploying plate cut along [`Deployment::latch_lines`]: the deployed
     /// spacecraft whose wing stands on its compliant latches (`st` unchanged with rigid ones).
+    ///
+    /// The cable ties the latched hinges as it tied the opening ones, in the lines' rotations
+    /// θ_j = d_j δα_j (δα_j = α_j − α_j^L, d_j = ∓1 the sign of α_j in the panel angles): an
+    /// ideal cable leaves one motion, δα = r s with r = (1, 2, 2, …) (one kink function
+    /// Σ_j d_j r_j K_j); an elastic one adds k_c (C D)ᵀ(C D) between the lines (C the cable
+    /// law's rows, D = diag(d_j)). The lines rest where the potential
+    /// V = Σ ½ k_j (δα_j − (α_j^ref − α_j^L))² + ½ k_L,j δα_j² + ½ k_c |C (δα + α^L − α(0))|²
+    /// is least over the kink functions' motions: (W K Wᵀ) s = W f with
+    /// f_j = d_j [k_j (α_j^ref − α_j^L) − k_c (Cᵀ C (α^L − α(0)))_j], rest = Wᵀ s.
     pub fn latched_structure(
         &self,
         st: &Structure,
     ) -> Result<Structure, crate::structure::StructureError> {
-        let lines = self.latch_lines();
+        let mut lines = self.latch_lines();
         let mut st = st.clone();
         if lines.is_empty() {
             return Ok(st);
@@ -683,19 +694,21 @@ impl Deployment {
         let Some(p) = st.plates.iter_mut().find(|p| p.name == self.plate) else {
             return Ok(st);
         };
-        let hinged = p.clone().with_hinges(lines)?;
-        // The cable ties the latched hinges as it tied the opening ones, in the lines'
-        // rotations θ_j = d_j δα_j: an ideal cable leaves one motion, δα = r s with
-        // r = (1, 2, 2, …) (one kink function Σ_j d_j r_j K_j); an elastic one adds
-        // k_c (C D)ᵀ(C D) between the lines (C the cable law's rows, D = diag(d_j)).
-        *p = match self.synchronisation {
-            Synchronisation::None => hinged,
-            Synchronisation::IdealCable => hinged.with_tied_hinges(
+        let d: Vec<f64> = (0..n).map(Chain::d).collect();
+        let identity = |n: usize| -> Vec<Vec<f64>> {
+            (0..n)
+                .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
+                .collect()
+        };
+        let (functions, coupling, kc) = match self.synchronisation {
+            Synchronisation::None => (identity(n), Vec::new(), 0.0),
+            Synchronisation::IdealCable => (
                 vec![(0..n)
-                    .map(|j| Chain::d(j) * if j == 0 { 1.0 } else { 2.0 })
+                    .map(|j| d[j] * if j == 0 { 1.0 } else { 2.0 })
                     .collect()],
                 Vec::new(),
-            )?,
+                0.0,
+            ),
             Synchronisation::ElasticCable(kc) => {
                 let rows = Coupled::cable_law(n);
                 let coupling = (0..n)
@@ -703,16 +716,55 @@ impl Deployment {
                         (0..n)
                             .map(|l| {
                                 let c: f64 = rows.iter().map(|r| r[j] * r[l]).sum();
-                                kc * c * Chain::d(j) * Chain::d(l)
+                                kc * c * d[j] * d[l]
                             })
                             .collect()
                     })
                     .collect();
-                let identity = (0..n)
-                    .map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect())
-                    .collect();
-                hinged.with_tied_hinges(identity, coupling)?
+                (identity(n), coupling, kc)
             }
+        };
+        // The rest rotations: the least potential over the kink functions' motions.
+        let hinges = &self.chain.hinges;
+        let mut f: Vec<f64> = (0..n)
+            .map(|j| {
+                d[j] * hinges[j].stiffness * (hinges[j].reference_angle - hinges[j].latch_angle)
+            })
+            .collect();
+        if kc > 0.0 {
+            let rows = Coupled::cable_law(n);
+            let offset: Vec<f64> = (0..n)
+                .map(|j| hinges[j].latch_angle - hinges[j].initial_angle)
+                .collect();
+            for r in &rows {
+                let m: f64 = r.iter().zip(&offset).map(|(a, b)| a * b).sum();
+                for j in 0..n {
+                    f[j] -= d[j] * kc * r[j] * m;
+                }
+            }
+        }
+        let stiff = |j: usize, l: usize| -> f64 {
+            let own = if j == l { lines[j].stiffness } else { 0.0 };
+            own + coupling.get(j).map_or(0.0, |r: &Vec<f64>| r[l])
+        };
+        let nf = functions.len();
+        let a = faer::Mat::<f64>::from_fn(nf, nf, |i, k| {
+            (0..n)
+                .flat_map(|j| (0..n).map(move |l| (j, l)))
+                .map(|(j, l)| functions[i][j] * stiff(j, l) * functions[k][l])
+                .sum()
+        });
+        let b =
+            faer::Mat::<f64>::from_fn(nf, 1, |i, _| (0..n).map(|j| functions[i][j] * f[j]).sum());
+        use faer::linalg::solvers::Solve;
+        let s = a.as_ref().partial_piv_lu().solve(&b);
+        for (j, line) in lines.iter_mut().enumerate() {
+            line.rest = (0..nf).map(|i| functions[i][j] * s[(i, 0)]).sum();
+        }
+        let hinged = p.clone().with_hinges(lines)?;
+        *p = match self.synchronisation {
+            Synchronisation::None => hinged,
+            _ => hinged.with_tied_hinges(functions, coupling)?,
         };
         Ok(st)
     }

@@ -285,7 +285,10 @@ impl ExportModel {
         let zeta: Vec<f64> = damping_ratios(&settings.damping, kept)?
             .into_iter()
             .zip(elastic.iter())
-            .map(|(z, m)| (z + lines[m.number - 1]).min(crate::ritz::modes::MAX_ZETA))
+            .map(|(z, m)| match lines[m.number - 1] {
+                add if add > 0.0 => (z + add).min(crate::ritz::modes::MAX_ZETA.max(z)),
+                _ => z,
+            })
             .collect();
         let rigid: Vec<_> = modes.modes.iter().filter(|m| m.rigid).collect();
         let chosen: Vec<(&crate::ritz::Mode, f64)> = rigid

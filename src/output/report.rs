@@ -603,8 +603,14 @@ fn coefficient_tables(sim: &Simulation, o: &mut String) {
                     let _ = write!(o, "<th>n = {}</th>", n + 1);
                 }
                 o.push_str("</tr>");
-                for mi in 0..t.length {
-                    let _ = write!(o, "<tr><th>m = {}</th>", mi + 1);
+                // The smooth functions, then a cut wing's kink functions (latch lines).
+                let kinks = st.plates()[i].hinge_functions().len();
+                for mi in 0..t.length + kinks {
+                    if mi < t.length {
+                        let _ = write!(o, "<tr><th>m = {}</th>", mi + 1);
+                    } else {
+                        let _ = write!(o, "<tr><th>kink {}</th>", mi - t.length + 1);
+                    }
                     for n in 0..t.width {
                         o.push_str(&cell(m.shape[start + mi * t.width + n]));
                     }

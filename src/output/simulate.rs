@@ -51,9 +51,10 @@ fn response_json(sim: &Simulation, s: &Scenario, r: &Response) -> Value {
             "angle_mismatch": h.angle_mismatch,
             "elastic_energy_before": h.elastic_energy_before,
             "elastic_energy_after": h.elastic_energy_after,
-            "projection_residual": (h.energy_before + h.elastic_energy_before) - (h.energy_after + h.elastic_energy_after),
+            "projection_residual": (h.energy_before + h.elastic_energy_before + h.lines_energy) - (h.energy_after + h.elastic_energy_after),
             "latch_energy": h.latch_energy,
             "latch_energy_carried": h.latch_carried,
+            "latch_lines_energy": h.lines_energy,
         },
         "response": {
             "duration": st.duration,
@@ -301,14 +302,15 @@ fn handover_lines(o: &mut String, r: &Response, (_, p_scale, l_scale): (f64, f64
         lost,
         100.0 * lost / h.energy_before.max(1e-300)
     );
-    // With the latch lines in the deployed model its elastic energy holds the latch springs'.
-    let carried = if h.latch_carried { h.latch_energy } else { 0.0 };
+    // With the latch lines in the deployed model its elastic energy holds the lines' (latch,
+    // hinge and cable springs about the latched equilibrium).
+    let carried = if h.latch_carried { h.lines_energy } else { 0.0 };
     let (before, after) = (
         h.energy_before + h.elastic_energy_before + carried,
         h.energy_after + h.elastic_energy_after,
     );
     let springs = if h.latch_carried {
-        format!(" (base) + {:.6e} J (latch springs)", h.latch_energy)
+        format!(" (base) + {:.6e} J (latch lines)", h.lines_energy)
     } else {
         String::new()
     };

@@ -125,6 +125,10 @@ pub struct Handover {
     /// The deployed model carries the latch springs (its wing is cut along hinge lines,
     /// docs/theory.md §1.6): the latched array's motion goes on in the response.
     pub latch_carried: bool,
+    /// With [`Handover::latch_carried`]: the latch lines' energy about their rest at the
+    /// hand-over, ½ Δθᵀ K Δθ (latch, hinge and cable springs together, about the latched
+    /// equilibrium), J — what the deployed model's elastic energy holds of them.
+    pub lines_energy: f64,
     /// Notes on choices the data forced (printed as warnings).
     pub notes: Vec<String>,
 }
@@ -438,6 +442,7 @@ pub fn hand_over(
         elastic_energy_after: 0.0,
         latch_energy: 0.0,
         latch_carried: false,
+        lines_energy: 0.0,
         notes,
     })
 }
@@ -481,11 +486,11 @@ fn base_state(coupled: &Coupled, model: &RitzModel, y: &[f64]) -> (Vec<f64>, Vec
 }
 
 /// The deployed wing's hinge lines (docs/theory.md §1.6) take the captured hinges' angles
-/// off their equilibrium as kinks: hinge j at α_j turns its outboard side by
-/// θ_j = d_j (α_j − α_j^eq) about ẑ = e_a × n (d_j = ∓1 the chain's sign of α_j in the panel
-/// angles), α_j^eq = (k_j α_j^ref + k_L,j α_j^L)/(k_j + k_L,j) the angle at which the latch
-/// spring holds the hinge spring's preload (the straight deployed wing is the model's
-/// equilibrium). The kink functions F_i = Σ_j W_ij K_j take the rotations that fit them in
+/// off their rest as kinks: hinge j at α_j turns its outboard side by
+/// θ_j = d_j (α_j − α_j^L) about ẑ = e_a × n (d_j = ∓1 the chain's sign of α_j in the panel
+/// angles), less the line's rest rotation ([`crate::structure::LineHinge::rest`]: where the
+/// latches hold the hinge springs' and the cable's preload; the straight deployed wing is
+/// the model's equilibrium). The kink functions F_i = Σ_j W_ij K_j take the rotations that fit them in
 /// least squares weighted by the lines' stiffness (exact for independent lines, W = I, and
 /// for a state on an ideal cable's manifold), less the fit of the equilibrium's offsets, and
 /// their coordinates h_in (W = Σ F_i(x/a) h_in Y_n) the uniform
@@ -500,10 +505,10 @@ fn latch_displacement(
     y: &[f64],
     view: &PlateView<'_>,
     q0: &mut [f64],
-) -> Option<f64> {
+) -> Option<(f64, f64)> {
     let lines = view.plate.hinges();
     let w = view.plate.hinge_functions();
-    let latch = coupled.latch.as_ref()?;
+    coupled.latch.as_ref()?;
     if lines.is_empty() || w.is_empty() {
         return None;
     }
@@ -516,17 +521,14 @@ fn latch_displacement(
     let ev = coupled.evaluate(y);
     let z_plate = view.plate.length_axis.cross(view.plate.normal);
     let sense = ev.frame.apply(Vec3::new(0.0, 0.0, 1.0)).dot(z_plate);
-    // θ_j off the latch angle, and the equilibrium's own offset from it.
-    let (mut theta, mut offset) = (Vec::new(), Vec::new());
-    for (j, h) in coupled.chain.hinges.iter().enumerate().take(lines.len()) {
-        let (k, kl) = (h.stiffness, latch.stiffness[j]);
-        let eq = (k * h.reference_angle + kl * h.latch_angle) / (k + kl);
-        theta.push(Chain::d(j) * (sv.alpha[j] - h.latch_angle) * sense);
-        offset.push(Chain::d(j) * (eq - h.latch_angle) * sense);
-    }
-    // The lines' stiffness-weighted fit (W K Wᵀ) s = W K θ: on an ideal cable's manifold the
-    // fit of the offsets is the tied array's own equilibrium, the minimum of Σ ½ K_j (θ_j −
-    // offset_j)² over its one motion.
+    // θ_j off the latch angle; the lines' rest rotations (the latched equilibrium).
+    let theta: Vec<f64> = (coupled.chain.hinges.iter().enumerate())
+        .take(lines.len())
+        .map(|(j, h)| Chain::d(j) * (sv.alpha[j] - h.latch_angle) * sense)
+        .collect();
+    let rest: Vec<f64> = lines.iter().map(|l| l.rest).collect();
+    // The lines' stiffness-weighted fit (W K Wᵀ) s = W K θ, exact for independent lines and
+    // on an ideal cable's manifold (where the rest rotations lie too).
     let nf = w.len();
     let kw: Vec<f64> = lines.iter().map(|l| l.stiffness).collect();
     let wdot = |a: &[f64], b: &[f64]| (0..a.len()).map(|j| a[j] * kw[j] * b[j]).sum::<f64>();
@@ -537,17 +539,24 @@ fn latch_displacement(
         let s = lu.solve(&rhs);
         (0..nf).map(|i| s[(i, 0)]).collect::<Vec<f64>>()
     };
-    let (s_state, s_eq) = (fit(&theta), fit(&offset));
-    for i in 0..nf {
+    let (s_state, s_rest) = (fit(&theta), fit(&rest));
+    let ds: Vec<f64> = s_state.iter().zip(&s_rest).map(|(a, b)| a - b).collect();
+    for (i, dsi) in ds.iter().enumerate() {
         for (n, cn) in c.iter().enumerate() {
-            q0[start + (smooth + i) * ny + n] += view.plate.length * (s_state[i] - s_eq[i]) * cn;
+            q0[start + (smooth + i) * ny + n] += view.plate.length * dsi * cn;
         }
     }
-    Some(
-        (0..lines.len())
-            .map(|j| (theta[j] - (0..nf).map(|i| w[i][j] * s_state[i]).sum::<f64>()).abs())
-            .fold(0.0, f64::max),
-    )
+    // The lines' energy about their rest, ½ Δsᵀ S Δs (S per radian², uniform rotations).
+    let stiff = view.plate.hinge_function_matrix(false);
+    let energy = 0.5
+        * (0..nf)
+            .flat_map(|i| (0..nf).map(move |k| (i, k)))
+            .map(|(i, k)| ds[i] * stiff[i][k] * ds[k])
+            .sum::<f64>();
+    let residual = (0..lines.len())
+        .map(|j| (theta[j] - (0..nf).map(|i| w[i][j] * s_state[i]).sum::<f64>()).abs())
+        .fold(0.0, f64::max);
+    Some((residual, energy))
 }
 
 /// The coefficients c of the constant function in a family: ∫Y_m Y_n c_n = ∫Y_m (the
@@ -627,8 +636,10 @@ pub fn hand_over_coupled(
     let n = model.dof();
     let y = result.final_state();
     let (base_velocity, mut q0) = base_state(coupled, model, &y);
-    let residual = latch_displacement(coupled, &y, &view, &mut q0);
-    let carried = residual.is_some();
+    let carried_lines = latch_displacement(coupled, &y, &view, &mut q0);
+    let carried = carried_lines.is_some();
+    let residual = carried_lines.map(|(r, _)| r);
+    let lines_energy = carried_lines.map_or(0.0, |(_, e)| e);
     let pl = coupled_pre_latch(coupled, &y, view.plate.length_axis, base_velocity);
     let mut notes = Vec::new();
     let energy_before = coupled.kinetic_energy(&y);
@@ -731,6 +742,7 @@ pub fn hand_over_coupled(
         elastic_energy_after,
         latch_energy: coupled.latch_energy(&y, &vec![true; coupled.panels()]),
         latch_carried: carried,
+        lines_energy,
         notes,
     })
 }

@@ -23,7 +23,7 @@
 //!   latch angle, the static preload the unstressed plate does not carry, so that a settled
 //!   deployment and the response's start agree. A wing cut along compliant latch lines
 //!   (docs/theory.md §1.6) reports the latch's own moment from the lines' rotation and rate
-//!   instead ([`latch_line_channels`]). The lines are at the panels' true positions.
+//!   instead (`latch_line_channels`). The lines are at the panels' true positions.
 
 use super::channels::{Channel, ChannelKind, Order};
 use crate::basis::{Basis1d, Quadrature};
@@ -157,10 +157,10 @@ pub fn latch_channels(
 
 /// The compliant latches' own moments on a wing cut along its latch lines (docs/theory.md
 /// §1.6), as in the deployment: M_j = −k_L,j (α_j − α_j^L) − c_L,j α̇_j. Line j turns by
-/// the mean θ̄_j = (1/a) Σ_i W_ij Σ_n h_in ∫Y_n dη of its kink functions' coordinates, and
-/// α_j − α_j^eq = d_j θ̄_j about the equilibrium α_j^eq = (k_j α_j^ref + k_L,j α_j^L)/(k_j +
-/// k_L,j) the straight model stands for: a displacement row −k_L,j d_j ∂θ̄_j/∂q, a rate row
-/// −c_L,j d_j ∂θ̄_j/∂q and the constant −k_L,j (α_j^eq − α_j^L). The latch's share only: the
+/// the mean θ̄_j = (1/a) Σ_i W_ij Σ_n h_in ∫Y_n dη of its kink functions' coordinates beyond
+/// its rest rotation ρ_j (the latched equilibrium the straight model stands for), and
+/// α_j − α_j^L = d_j (θ̄_j + ρ_j): a displacement row −k_L,j d_j ∂θ̄_j/∂q, a rate row
+/// −c_L,j d_j ∂θ̄_j/∂q and the constant −k_L,j d_j ρ_j. The latch's share only: the
 /// hinge spring's and, with a cable, the cable's moments through the line are not in it.
 /// The lines hold k_L + k and c_L + c; the hinges give k and c.
 fn latch_line_channels(
@@ -183,7 +183,6 @@ fn latch_line_channels(
         .map(|(j, (h, line))| {
             let (kl, cl) = (line.stiffness - h.stiffness, line.damping - h.damping);
             let d = if j % 2 == 0 { -1.0 } else { 1.0 };
-            let eq = (h.stiffness * h.reference_angle + kl * h.latch_angle) / line.stiffness;
             let mut dtheta = vec![0.0; model.dof()];
             for (i, wi) in w.iter().enumerate() {
                 for (n, yn) in y_means.iter().enumerate() {
@@ -198,7 +197,7 @@ fn latch_line_channels(
                 kind: ChannelKind::LatchMoment { hinge: k },
                 row: dtheta.iter().map(|v| -kl * d * v).collect(),
                 order: Order::Displacement,
-                offset: -kl * (eq - h.latch_angle),
+                offset: -kl * d * line.rest,
                 rate_row: Some(dtheta.iter().map(|v| -cl * d * v).collect()),
             }
         })

@@ -126,12 +126,14 @@ impl ModalResponse {
 
     /// Adds to every kept elastic mode's ζ the hinge lines' dashpots (docs/theory.md §1.6):
     /// `extra[number − 1]` = φ_jᵀ C φ_j / (2ω_j), the diagonal of the damping in modal
-    /// coordinates (the off-diagonal terms, second order for light damping, are left out). The
-    /// sum stays below [`MAX_ZETA`] (the closed form is the underdamped one).
+    /// coordinates (the off-diagonal terms, second order for light damping, are left out). A
+    /// sum with the dashpots stays below [`MAX_ZETA`] (or the ratio asked for, if larger).
     pub fn with_line_damping(mut self, extra: &[f64]) -> Self {
         for m in self.modes.iter_mut().filter(|m| !m.rigid) {
             let add = extra.get(m.number - 1).copied().unwrap_or(0.0);
-            m.zeta = (m.zeta + add).min(MAX_ZETA);
+            if add > 0.0 {
+                m.zeta = (m.zeta + add).min(MAX_ZETA.max(m.zeta));
+            }
         }
         self
     }

@@ -43,6 +43,8 @@ use crate::structure::HubMotion;
 use crate::structure::{ComponentId, Structure, MAX_TERMS};
 use faer::Mat;
 
+/// Keys of a cut plate's kink functions sit above every smooth function's index.
+const KINK_KEY: usize = 1 << 20;
 /// Slowest convergence rate assumed, in ω_k − ω_k,exact ≈ C n^(−p).
 pub const RATE_MIN: f64 = 1.0;
 /// Fastest rate believed. Measured: a cantilever plate's frequencies converge like n^(−5)
@@ -265,7 +267,9 @@ impl Ceiling {
             .all(|f| f.count(st) <= f.count(&self.structure))
     }
 
-    /// The global indices of `st`'s coordinates in the ceiling model, in `st`'s own order.
+    /// The global indices of `st`'s coordinates in the ceiling model, in `st`'s own order
+    /// (a cut plate's smooth length functions, then its kinks: the order of
+    /// [`crate::basis::Hinged`]).
     fn indices(&self, st: &Structure) -> (Vec<usize>, Vec<Key>) {
         let mut idx: Vec<usize> = (0..HUB_DOF).collect();
         let mut keys: Vec<Key> = (0..HUB_DOF).map(|i| (0, 0, i)).collect();
@@ -285,11 +289,19 @@ impl Ceiling {
                 }
                 ElementKind::Plate { index, .. } => {
                     let t = st.plates[index].terms;
-                    let full = self.structure.plates[index].terms.width;
+                    let ceiling = &self.structure.plates[index];
+                    let full = ceiling.terms.width;
                     let start = e.own_range().start;
                     for m in 0..t.length {
                         idx.extend((0..t.width).map(|w| start + m * full + w));
                         keys.extend((0..t.width).map(|w| (ei, m, w)));
+                    }
+                    // A cut plate's kink functions (latch lines) follow its smooth ones in
+                    // every model, the same functions at every level.
+                    for k in 0..ceiling.hinge_functions.len() {
+                        let m = ceiling.terms.length + k;
+                        idx.extend((0..t.width).map(|w| start + m * full + w));
+                        keys.extend((0..t.width).map(|w| (ei, KINK_KEY + k, w)));
                     }
                 }
                 ElementKind::Rigid => {}

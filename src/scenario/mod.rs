@@ -439,22 +439,24 @@ fn build(cx: &Ctx, raw: RawScenario) -> Result<Scenario, ScenarioError> {
         (Some(a), Some(b)) => Some(a.max(b)),
         (a, b) => a.or(b),
     };
-    let term_selection = ritz::select(cx, &raw, &structure, used_modes)?;
-    let structure = match &term_selection {
-        Some(sel) => sel.structure.clone(),
-        None => structure,
-    };
+    // The deployment is read on the structure as given (it uses the plate's geometry and
+    // mass, not its terms). Compliant latches stay in the deployed wing: its plate is cut
+    // along the hinge lines and joined by the latch springs (docs/theory.md §1.6) — before
+    // the automatic terms are chosen, so that they aim at the cut wing's modes.
     let deployment = match &raw.deployment {
         Some(d) => Some(deployment::lower(cx, d, &structure)?),
         None => None,
     };
-    // Compliant latches stay in the deployed wing: its plate is cut along the hinge lines
-    // and joined by the latch springs (docs/theory.md §1.6).
     let structure = match (&deployment, &raw.deployment) {
         (Some(d), Some(rd)) => d
             .latched_structure(&structure)
             .map_err(|e| cx.invalid(rd.span(), "deployment.latch", e.to_string()))?,
         _ => structure,
+    };
+    let term_selection = ritz::select(cx, &raw, &structure, used_modes)?;
+    let structure = match &term_selection {
+        Some(sel) => sel.structure.clone(),
+        None => structure,
     };
     let montecarlo = match &raw.montecarlo {
         Some(m) => Some(montecarlo::lower(

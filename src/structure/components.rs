@@ -574,6 +574,10 @@ pub struct LineHinge {
     pub stiffness: f64,
     /// c_L, N·m·s/rad, likewise.
     pub damping: f64,
+    /// The line's rotation at the latched array's equilibrium, rad, about e_a × n: where the
+    /// latch springs hold the hinge springs' preload (and a cable's); the straight plate is
+    /// the model's equilibrium, so a hand-over and the latch moments measure from it.
+    pub rest: f64,
 }
 
 impl Plate {
@@ -650,6 +654,12 @@ impl Plate {
                     "hinge line {}: stiffness {:e} N·m/rad must be positive and finite",
                     i + 1,
                     h.stiffness
+                ))
+            } else if !h.rest.is_finite() {
+                Some(format!(
+                    "hinge line {}: rest rotation {:e} rad is not finite",
+                    i + 1,
+                    h.rest
                 ))
             } else if !(h.damping.is_finite() && h.damping >= 0.0) {
                 Some(format!(

@@ -728,7 +728,8 @@ fn the_latch_period_is_the_captured_arrays_slowest_mode() {
 /// The hand-over after compliant latches reports the latch springs' energy,
 /// ½ Σ k_L,j (α_j − α_j^L)² at the deployment's final state, and carries it: the deployed
 /// wing stands on its latch lines (docs/theory.md §1.6), so the energy handed over — kinetic,
-/// the base's elastic energy and the latch springs' — is what the response starts with, to
+/// the base's elastic energy and the lines' (latch and hinge springs about the latched
+/// rest, within 5 % of the latch springs' alone here) — is what the response starts with, to
 /// the projection's residual (below 1e-3 of it; measured 6.5e-5 on seed_compliant). The run
 /// ends one latch period after the last capture (`Settled::HandedOver`), however lightly the
 /// latches are damped.
@@ -757,16 +758,23 @@ fn the_hand_over_carries_the_latch_springs() {
         );
         assert!(h.latch_carried && expected > 0.0);
         assert_eq!(h.settled, Some(Settled::HandedOver));
-        let before = h.energy_before + h.elastic_energy_before + h.latch_energy;
+        let before = h.energy_before + h.elastic_energy_before + h.lines_energy;
         let after = h.energy_after + h.elastic_energy_after;
         assert!(
             (before - after).abs() < 1e-3 * before,
             "damping {damping}: {before} J before, {after} J after"
         );
-        // Without the latch springs' share the books would not close by far more.
+        // Without the latch lines' share the books would not close by far more; the lines
+        // hold the latch springs' energy and the hinge springs' about the latched rest.
         assert!(
-            h.latch_energy > 10.0 * (before - after).abs(),
+            h.lines_energy > 10.0 * (before - after).abs(),
             "damping {damping}"
+        );
+        assert!(
+            (h.lines_energy - h.latch_energy).abs() < 0.05 * h.latch_energy,
+            "{} vs {}",
+            h.lines_energy,
+            h.latch_energy
         );
     }
 }
@@ -946,4 +954,44 @@ damping = 0.0
 friction = 0.0
 "#
     )
+}
+
+/// The latch lines' rest rotations (`LineHinge::rest`: where the latches hold the hinge
+/// springs' preload, and the cable ties the hinges) against the deployment itself come to
+/// rest: a held wing of three unequal panels, heavily damped latches of unequal stiffness
+/// (ζ ≈ 0.6 on the slowest latch mode, the whole wing about its root at 0.5 rad/s), run
+/// 120 s past the last capture. Its final angles off the latch angles, as line
+/// rotations d_j (α_j − α_j^L), are the rest rotations — independent hinges, an ideal cable
+/// (one tied motion: not each hinge's own equilibrium) and an elastic one — to 1e-6 of the
+/// largest (the run's own decay and tolerance).
+#[test]
+fn the_latch_lines_rest_where_the_deployment_comes_to_rest() {
+    for sync in [
+        "synchronisation = \"none\"",
+        "synchronisation = \"cable\"",
+        "synchronisation = \"cable\"\ncable_stiffness = 150.0",
+    ] {
+        let src = held_wing(
+            1e7,
+            &format!("{sync}\nend_time = 400.0"),
+            "stiffness = [300.0, 200.0, 120.0]\ndamping = 600.0\nsettle_time = 120.0",
+        );
+        let sc = Scenario::from_toml_str(&src, "held.toml").unwrap();
+        let (c, r) = simulate_coupled(&sc.structure, sc.deployment.as_ref().unwrap()).unwrap();
+        assert!(r.all_latched, "{sync}");
+        let lines = sc.structure.plates()[0].hinges();
+        let off = c.alpha_offset();
+        let largest = lines.iter().fold(0.0_f64, |m, l| m.max(l.rest.abs()));
+        assert!(largest > 1e-4, "{sync}: a preload to hold ({largest} rad)");
+        for (j, (h, l)) in c.chain.hinges.iter().zip(lines).enumerate() {
+            let d = if j % 2 == 0 { -1.0 } else { 1.0 };
+            let theta = d * (r.final_q[off + j] - h.latch_angle);
+            assert!(
+                (theta - l.rest).abs() < 1e-6 * largest,
+                "{sync}: hinge {}: at rest {theta:e} rad, line rest {:e} rad",
+                j + 1,
+                l.rest
+            );
+        }
+    }
 }
