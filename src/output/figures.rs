@@ -139,10 +139,32 @@ pub fn clean(figs: &mut [Figure], length: f64) {
                         .all(|(x, y)| (x - y).abs() <= 1e-12 * scale)
             });
             if let Some(j) = same {
-                let other = f.curves[j].0.clone();
+                let other = short_name(&f.curves[i].0, &f.curves[j].0);
                 f.curves[i].0 = format!("{} (coincides with {other})", f.curves[i].0);
             }
         }
+    }
+}
+
+/// `other` from the word before the one where it departs from `name` ("latch moment,
+/// hinge 2" beside "latch moment, hinge 3" is "hinge 2"), so that a legend entry stays short.
+fn short_name(name: &str, other: &str) -> String {
+    let common = name
+        .char_indices()
+        .zip(other.chars())
+        .find(|((_, a), b)| a != b)
+        .map_or(name.len().min(other.len()), |((i, _), _)| i);
+    // The word where they differ, and the one before it.
+    let word = other[..common].rfind([' ', ',']).map_or(0, |i| i + 1);
+    let cut = other[..word]
+        .trim_end_matches([' ', ','])
+        .rfind([' ', ','])
+        .map_or(0, |i| i + 1);
+    let short = other[cut..].trim_start();
+    if short.is_empty() {
+        other.to_string()
+    } else {
+        short.to_string()
     }
 }
 
@@ -739,6 +761,17 @@ fn load_figures(
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_coinciding_curve_names_the_other_by_what_differs() {
+        use super::short_name;
+        assert_eq!(
+            short_name("latch moment, hinge 3", "latch moment, hinge 2"),
+            "hinge 2"
+        );
+        assert_eq!(short_name("mast tip v", "wing tip w"), "wing tip w");
+        assert_eq!(short_name("hinge 12", "hinge 1"), "hinge 1");
+    }
+
     use super::*;
 
     fn signal(n: usize) -> Vec<f64> {
