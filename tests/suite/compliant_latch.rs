@@ -730,7 +730,7 @@ fn the_latch_period_is_the_captured_arrays_slowest_mode() {
 /// wing stands on its latch lines (docs/theory.md §1.6), so the energy handed over — kinetic,
 /// the base's elastic energy and the lines' (latch and hinge springs about the latched
 /// rest, within 5 % of the latch springs' alone here) — is what the response starts with, to
-/// the projection's residual (below 1e-3 of it; measured 6.5e-5 on seed_compliant). The run
+/// the projection's residual (below 1e-3 of it; measured 3e-9 on seed_compliant). The run
 /// ends one latch period after the last capture (`Settled::HandedOver`), however lightly the
 /// latches are damped.
 #[test]
