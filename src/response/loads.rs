@@ -182,7 +182,7 @@ fn latch_line_channels(
         .enumerate()
         .map(|(j, (h, line))| {
             let (kl, cl) = (line.stiffness - h.stiffness, line.damping - h.damping);
-            let d = if j % 2 == 0 { -1.0 } else { 1.0 };
+            let d = crate::deploy::chain::Chain::d(j);
             let mut dtheta = vec![0.0; model.dof()];
             for (i, wi) in w.iter().enumerate() {
                 for (n, yn) in y_means.iter().enumerate() {
